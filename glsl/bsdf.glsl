@@ -1,0 +1,246 @@
+// The material model (docs/materials.md): a linear blend of a Lambertian lobe, a GGX conductor
+// and a GGX (or smooth) dielectric. All directions point away from the surface; n is the geometric
+// normal as wound. Twin: src/bsdf.rs.
+#ifndef BSDF_GLSL
+#define BSDF_GLSL
+
+#include "sampling.glsl"
+#include "types.glsl"
+
+// Below this alpha (roughness 0.01) a lobe is treated as a perfect (delta) specular.
+const float DELTA_ALPHA = 1e-4;
+
+const uint LOBE_NONE = 0u;
+const uint LOBE_DIFFUSE = 1u;
+const uint LOBE_CONDUCTOR = 2u;
+const uint LOBE_DIELECTRIC = 4u;
+const uint LOBE_DELTA = 8u;
+const uint LOBE_TRANSMISSION = 16u;
+
+struct BsdfSample {
+    vec3 wi;
+    vec3 weight;   // f * |cos| / pdf
+    float pdf;     // solid-angle pdf of the whole mixture, or the discrete probability for delta lobes
+    uint lobe;     // LOBE_* bits; LOBE_NONE when sampling failed
+};
+
+float ggx_alpha(float roughness) { return roughness * roughness; }
+
+float ggx_d(vec3 h, float alpha) {
+    float a2 = alpha * alpha;
+    float c2 = h.z * h.z;
+    float d = c2 * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+float smith_lambda(vec3 w, float alpha) {
+    float c2 = w.z * w.z;
+    if (c2 <= 0.0) return 0.0;
+    float t2 = max(0.0, 1.0 - c2) / c2;
+    return 0.5 * (-1.0 + sqrt(1.0 + alpha * alpha * t2));
+}
+
+float smith_g1(vec3 w, float alpha) { return 1.0 / (1.0 + smith_lambda(w, alpha)); }
+
+float smith_g2(vec3 wo, vec3 wi, float alpha) {
+    return 1.0 / (1.0 + smith_lambda(wo, alpha) + smith_lambda(wi, alpha));
+}
+
+// Density of visible normal h seen from wo: G1(wo) max(0, wo.h) D(h) / |wo.z|.
+float ggx_vndf_pdf(vec3 wo, vec3 h, float alpha) {
+    return smith_g1(wo, alpha) * max(0.0, dot(wo, h)) * ggx_d(h, alpha) / abs(wo.z);
+}
+
+vec3 fresnel_schlick(vec3 f0, float cos_theta) {
+    float m = clamp(1.0 - cos_theta, 0.0, 1.0);
+    float m5 = (m * m) * (m * m) * m;
+    return f0 + (1.0 - f0) * m5;
+}
+
+// Unpolarised Fresnel reflectance; cos_i < 0 means the ray arrives from inside (eta inverted).
+float fresnel_dielectric(float cos_i, float eta) {
+    if (cos_i < 0.0) { eta = 1.0 / eta; cos_i = -cos_i; }
+    float sin2_t = max(0.0, 1.0 - cos_i * cos_i) / (eta * eta);
+    if (sin2_t >= 1.0) return 1.0;
+    float cos_t = sqrt(1.0 - sin2_t);
+    float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (r_par * r_par + r_perp * r_perp);
+}
+
+// Refraction of w about normal m (both local); returns false on total internal reflection.
+// etap receives the relative IOR actually used (eta or 1/eta).
+bool refract_dir(vec3 w, vec3 m, float eta, out vec3 wt, out float etap) {
+    float cos_i = dot(m, w);
+    if (cos_i < 0.0) { eta = 1.0 / eta; cos_i = -cos_i; m = -m; }
+    float sin2_t = max(0.0, 1.0 - cos_i * cos_i) / (eta * eta);
+    etap = eta;
+    wt = vec3(0.0);
+    if (sin2_t >= 1.0) return false;
+    float cos_t = sqrt(1.0 - sin2_t);
+    wt = -w / eta + (cos_i / eta - cos_t) * m;
+    return true;
+}
+
+void lobe_weights(Material m, out float w_diffuse, out float w_conductor, out float w_dielectric) {
+    float t = clamp(m.transmission, 0.0, 1.0);
+    float k = clamp(m.metallic, 0.0, 1.0);
+    w_diffuse = (1.0 - t) * (1.0 - k);
+    w_conductor = (1.0 - t) * k;
+    w_dielectric = t;
+}
+
+// Rough dielectric f*|cos_i| and pdf (local frame; n = +z is the outside).
+void dielectric_eval_pdf(vec3 wo, vec3 wi, float alpha, float eta, out float f_cos, out float pdf) {
+    f_cos = 0.0;
+    pdf = 0.0;
+    float cos_o = wo.z, cos_i = wi.z;
+    if (cos_o == 0.0 || cos_i == 0.0) return;
+    bool reflect = cos_o * cos_i > 0.0;
+    float etap = reflect ? 1.0 : (cos_o > 0.0 ? eta : 1.0 / eta);
+    vec3 wm = wi * etap + wo;
+    if (dot(wm, wm) == 0.0) return;
+    wm = normalize(wm);
+    if (wm.z < 0.0) wm = -wm;
+    // Microfacets facing away from either direction carry nothing.
+    if (dot(wm, wi) * cos_i < 0.0 || dot(wm, wo) * cos_o < 0.0) return;
+    float fr = fresnel_dielectric(dot(wo, wm), eta);
+    float d = ggx_d(wm, alpha);
+    float g = smith_g2(wo, wi, alpha);
+    vec3 wo_up = wo * sign(cos_o);
+    float vis = smith_g1(wo_up, alpha) * abs(dot(wo, wm)) * d / abs(cos_o);
+    if (reflect) {
+        f_cos = d * g * fr / (4.0 * abs(cos_o));
+        pdf = vis / (4.0 * abs(dot(wo, wm))) * fr;
+    } else {
+        float denom = dot(wi, wm) + dot(wo, wm) / etap;
+        denom *= denom;
+        f_cos = d * (1.0 - fr) * g * abs(dot(wi, wm) * dot(wo, wm) / (cos_o * denom)) / (etap * etap);
+        pdf = vis * abs(dot(wi, wm)) / denom * (1.0 - fr);
+    }
+}
+
+// Sum over the non-delta lobes of f * |cos_i| (local frame, n = +z as wound).
+void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float pdf) {
+    float w_d, w_c, w_t;
+    lobe_weights(m, w_d, w_c, w_t);
+    float alpha = ggx_alpha(m.roughness);
+    f_cos = vec3(0.0);
+    pdf = 0.0;
+    // Opaque lobes reflect on whichever side wo lies.
+    float side = wo.z < 0.0 ? -1.0 : 1.0;
+    vec3 wo_s = wo * vec3(1.0, 1.0, side);
+    vec3 wi_s = wi * vec3(1.0, 1.0, side);
+    bool same_side = wo_s.z > 0.0 && wi_s.z > 0.0;
+    if (w_d > 0.0 && same_side) {
+        f_cos += w_d * m.base_color * INV_PI * wi_s.z;
+        pdf += w_d * pdf_cosine_hemisphere(wi_s.z);
+    }
+    if (w_c > 0.0 && same_side && alpha >= DELTA_ALPHA) {
+        vec3 h = normalize(wo_s + wi_s);
+        vec3 f = fresnel_schlick(m.base_color, dot(wo_s, h));
+        f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
+        pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
+    }
+    if (w_t > 0.0 && alpha >= DELTA_ALPHA) {
+        float fc, p;
+        dielectric_eval_pdf(wo, wi, alpha, m.ior, fc, p);
+        f_cos += w_t * m.base_color * fc;
+        pdf += w_t * p;
+    }
+}
+
+vec3 bsdf_eval(Material m, vec3 n, vec3 wo, vec3 wi) {
+    vec3 t, b;
+    build_onb(n, t, b);
+    vec3 f_cos;
+    float pdf;
+    bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n), f_cos, pdf);
+    return f_cos;
+}
+
+float bsdf_pdf(Material m, vec3 n, vec3 wo, vec3 wi) {
+    vec3 t, b;
+    build_onb(n, t, b);
+    vec3 f_cos;
+    float pdf;
+    bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n), f_cos, pdf);
+    return pdf;
+}
+
+// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
+BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
+    BsdfSample s;
+    s.wi = vec3(0.0);
+    s.weight = vec3(0.0);
+    s.pdf = 0.0;
+    s.lobe = LOBE_NONE;
+    vec3 t, b;
+    build_onb(n, t, b);
+    vec3 wo = to_local(wo_world, t, b, n);
+    if (wo.z == 0.0) return s;
+    float w_d, w_c, w_t;
+    lobe_weights(m, w_d, w_c, w_t);
+    float alpha = ggx_alpha(m.roughness);
+    float side = wo.z < 0.0 ? -1.0 : 1.0;
+    vec3 wo_s = wo * vec3(1.0, 1.0, side);
+    vec3 wi;
+    uint lobe;
+    if (u.z < w_d) {
+        wi = sample_cosine_hemisphere(u.xy) * vec3(1.0, 1.0, side);
+        lobe = LOBE_DIFFUSE;
+    } else if (u.z < w_d + w_c) {
+        lobe = LOBE_CONDUCTOR;
+        if (alpha < DELTA_ALPHA) {
+            s.wi = to_world(vec3(-wo.x, -wo.y, wo.z), t, b, n);
+            s.weight = fresnel_schlick(m.base_color, wo_s.z);
+            s.pdf = w_c;
+            s.lobe = LOBE_CONDUCTOR | LOBE_DELTA;
+            return s;
+        }
+        vec3 h = sample_ggx_vndf(wo_s, alpha, u.xy);
+        wi = reflect(-wo_s, h) * vec3(1.0, 1.0, side);
+    } else {
+        lobe = LOBE_DIELECTRIC;
+        if (w_t <= 0.0) return s;
+        if (alpha < DELTA_ALPHA) {
+            float fr = fresnel_dielectric(wo.z, m.ior);
+            if (u.w < fr) {
+                s.wi = to_world(vec3(-wo.x, -wo.y, wo.z), t, b, n);
+                s.weight = m.base_color;
+                s.pdf = w_t * fr;
+                s.lobe = LOBE_DIELECTRIC | LOBE_DELTA;
+            } else {
+                vec3 wt;
+                float etap;
+                if (!refract_dir(wo, vec3(0.0, 0.0, 1.0), m.ior, wt, etap)) return s;
+                s.wi = to_world(wt, t, b, n);
+                s.weight = m.base_color / (etap * etap);
+                s.pdf = w_t * (1.0 - fr);
+                s.lobe = LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION;
+            }
+            return s;
+        }
+        // Visible normals are sampled from wo mirrored through the origin, as the pdf assumes.
+        vec3 wm = sample_ggx_vndf(wo * side, alpha, u.xy);
+        float fr = fresnel_dielectric(dot(wo, wm), m.ior);
+        if (u.w < fr) {
+            wi = reflect(-wo, wm);
+        } else {
+            float etap;
+            if (!refract_dir(wo, wm, m.ior, wi, etap)) return s;
+            lobe |= LOBE_TRANSMISSION;
+        }
+    }
+    vec3 f_cos;
+    float pdf;
+    bsdf_eval_pdf_local(m, wo, wi, f_cos, pdf);
+    if (!(pdf > 0.0)) return s;
+    s.wi = to_world(wi, t, b, n);
+    s.weight = f_cos / pdf;
+    s.pdf = pdf;
+    s.lobe = lobe;
+    return s;
+}
+
+#endif

@@ -1,0 +1,120 @@
+// Ray-triangle intersection and stack traversal of the flattened BVH. Expects the scene buffers
+// `triangles` and `nodes` (scene_bindings.glsl). Twin: src/bvh.rs.
+#ifndef BVH_GLSL
+#define BVH_GLSL
+
+#include "types.glsl"
+
+const uint NO_HIT = 0xffffffffu;
+const int BVH_STACK_SIZE = 64;
+
+struct Hit {
+    float t;
+    uint triangle;   // NO_HIT on a miss
+    vec2 bary;       // (b1, b2) of vertices v0 + e1 and v0 + e2
+};
+
+// Möller-Trumbore; hits with t in (0, tmax) count, from either side.
+bool intersect_triangle(vec3 o, vec3 d, Triangle tri, float tmax, out float t, out vec2 bary) {
+    vec3 p = cross(d, tri.e2);
+    float det = dot(tri.e1, p);
+    t = 0.0;
+    bary = vec2(0.0);
+    if (det == 0.0) return false;
+    float inv_det = 1.0 / det;
+    vec3 s = o - tri.v0;
+    float b1 = dot(s, p) * inv_det;
+    if (b1 < 0.0 || b1 > 1.0) return false;
+    vec3 q = cross(s, tri.e1);
+    float b2 = dot(d, q) * inv_det;
+    if (b2 < 0.0 || b1 + b2 > 1.0) return false;
+    t = dot(tri.e2, q) * inv_det;
+    bary = vec2(b1, b2);
+    return t > 0.0 && t < tmax;
+}
+
+// Slab test; returns the entry distance or +inf on a miss.
+float intersect_aabb(vec3 o, vec3 inv_d, vec3 lo, vec3 hi, float tmax) {
+    vec3 t0 = (lo - o) * inv_d;
+    vec3 t1 = (hi - o) * inv_d;
+    vec3 tn = min(t0, t1);
+    vec3 tf = max(t0, t1);
+    float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    float leave = min(min(tf.x, tf.y), min(tf.z, tmax));
+    return enter <= leave ? enter : 1.0 / 0.0;
+}
+
+vec3 safe_inverse(vec3 d) {
+    const float big = 1e30;
+    return vec3(d.x != 0.0 ? 1.0 / d.x : big, d.y != 0.0 ? 1.0 / d.y : big, d.z != 0.0 ? 1.0 / d.z : big);
+}
+
+// Closest hit when any_hit is false; the first hit found otherwise (shadow rays).
+Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
+    Hit hit;
+    hit.t = tmax;
+    hit.triangle = NO_HIT;
+    hit.bary = vec2(0.0);
+    vec3 inv_d = safe_inverse(d);
+    uint stack[BVH_STACK_SIZE];
+    int sp = 0;
+    if (intersect_aabb(o, inv_d, nodes[0].lo, nodes[0].hi, hit.t) == 1.0 / 0.0) return hit;
+    uint node = 0u;
+    while (true) {
+        BvhNode n = nodes[node];
+        if (n.count > 0u) {
+            for (uint i = n.index; i < n.index + n.count; ++i) {
+                float t;
+                vec2 bary;
+                if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)) {
+                    hit.t = t;
+                    hit.triangle = i;
+                    hit.bary = bary;
+                    if (any_hit) return hit;
+                }
+            }
+        } else {
+            uint left = node + 1u;
+            uint right = n.index;
+            float tl = intersect_aabb(o, inv_d, nodes[left].lo, nodes[left].hi, hit.t);
+            float tr = intersect_aabb(o, inv_d, nodes[right].lo, nodes[right].hi, hit.t);
+            bool hit_l = tl != 1.0 / 0.0;
+            bool hit_r = tr != 1.0 / 0.0;
+            if (hit_l && hit_r) {
+                uint near = tl <= tr ? left : right;
+                stack[sp++] = tl <= tr ? right : left;
+                node = near;
+                continue;
+            }
+            if (hit_l || hit_r) {
+                node = hit_l ? left : right;
+                continue;
+            }
+        }
+        if (sp == 0) break;
+        node = stack[--sp];
+    }
+    return hit;
+}
+
+Hit trace_closest(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, false); }
+bool trace_occluded(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, true).triangle != NO_HIT; }
+
+// Moves a ray origin off a surface by a few ulps along the normal, robust at any scale
+// (Wächter and Binder, Ray Tracing Gems ch. 6).
+vec3 offset_ray_origin(vec3 p, vec3 n) {
+    const float origin = 1.0 / 32.0;
+    const float float_scale = 1.0 / 65536.0;
+    const float int_scale = 256.0;
+    ivec3 of_i = ivec3(int_scale * n);
+    vec3 p_i = vec3(
+        intBitsToFloat(floatBitsToInt(p.x) + (p.x < 0.0 ? -of_i.x : of_i.x)),
+        intBitsToFloat(floatBitsToInt(p.y) + (p.y < 0.0 ? -of_i.y : of_i.y)),
+        intBitsToFloat(floatBitsToInt(p.z) + (p.z < 0.0 ? -of_i.z : of_i.z)));
+    return vec3(
+        abs(p.x) < origin ? p.x + float_scale * n.x : p_i.x,
+        abs(p.y) < origin ? p.y + float_scale * n.y : p_i.y,
+        abs(p.z) < origin ? p.z + float_scale * n.z : p_i.z);
+}
+
+#endif

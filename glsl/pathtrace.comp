@@ -1,0 +1,26 @@
+#version 460
+// Progressive path tracing: each invocation adds samples_per_dispatch paths to its pixel's sums.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "scene_bindings.glsl"
+#include "path_tracer.glsl"
+
+layout(std430, set = 0, binding = 5) buffer Accum { vec4 accum[]; };       // rgb: sum of L, w: count
+layout(std430, set = 0, binding = 6) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of L^2
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= width || p.y >= height) return;
+    uint pixel = p.y * width + p.x;
+    vec3 sum = vec3(0.0);
+    vec3 sum_sq = vec3(0.0);
+    for (uint s = 0u; s < samples_per_dispatch; ++s) {
+        vec3 l = trace_path(p, path_seed(pixel, sample_offset + s, render_seed));
+        sum += l;
+        sum_sq += l * l;
+    }
+    accum[pixel] += vec4(sum, float(samples_per_dispatch));
+    accum_sq[pixel].rgb += sum_sq;
+}

@@ -1,0 +1,30 @@
+// Set 0, bindings 0-4: the frame parameters and the scene. Kernels add their own from binding 5.
+// Twin of FrameParams: src/gpu_types.rs.
+#ifndef SCENE_BINDINGS_GLSL
+#define SCENE_BINDINGS_GLSL
+
+#include "types.glsl"
+
+layout(std140, set = 0, binding = 0) uniform FrameParams {
+    vec4 cam_position;   // w: tan(yfov / 2)
+    vec4 cam_right;      // w: aspect ratio (width / height)
+    vec4 cam_up;
+    vec4 cam_forward;
+    vec4 scene_env;      // rgb: constant environment radiance, w: probability NEE picks it
+    uint width;
+    uint height;
+    uint sample_offset;
+    uint samples_per_dispatch;
+    uint max_depth;
+    uint render_seed;
+    uint flags;
+    uint emitter_count;
+};
+const uint FLAG_RUSSIAN_ROULETTE = 1u;
+
+layout(std430, set = 0, binding = 1) readonly buffer Triangles { Triangle triangles[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Nodes { BvhNode nodes[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Materials { Material materials[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Emitters { Emitter emitters[]; };
+
+#endif

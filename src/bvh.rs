@@ -1,0 +1,309 @@
+//! Binned-SAH BVH built on the CPU and flattened depth-first, plus the traversal twin of
+//! glsl/bvh.glsl used as the oracle for GPU hits.
+
+use glam::{Vec2, Vec3};
+
+use crate::gpu_types::{BvhNode, Triangle};
+
+pub const NO_HIT: u32 = u32::MAX;
+const SAH_BINS: usize = 16;
+const MAX_LEAF_TRIANGLES: usize = 4;
+/// Past this depth splits fall back to the object median, which bounds the traversal stack.
+const SAH_MAX_DEPTH: usize = 40;
+pub const BVH_STACK_SIZE: usize = 64;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub triangle: u32,
+    pub bary: Vec2,
+}
+
+#[derive(Clone, Copy)]
+struct Aabb {
+    lo: Vec3,
+    hi: Vec3,
+}
+
+impl Aabb {
+    const EMPTY: Aabb = Aabb {
+        lo: Vec3::splat(f32::INFINITY),
+        hi: Vec3::splat(f32::NEG_INFINITY),
+    };
+    fn grow(&mut self, p: Vec3) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+    fn merge(&mut self, o: &Aabb) {
+        self.lo = self.lo.min(o.lo);
+        self.hi = self.hi.max(o.hi);
+    }
+    fn half_area(&self) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+}
+
+/// A BVH over `triangles`, which the build reorders so that leaves index them contiguously.
+pub struct Bvh {
+    pub nodes: Vec<BvhNode>,
+    /// order[i] is the input index of the triangle now at position i.
+    pub order: Vec<u32>,
+}
+
+struct Builder<'a> {
+    bounds: Vec<Aabb>,
+    centroids: Vec<Vec3>,
+    indices: &'a mut [u32],
+    nodes: Vec<BvhNode>,
+}
+
+impl Bvh {
+    pub fn build(triangles: &[Triangle]) -> Bvh {
+        let bounds: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| {
+                let mut b = Aabb::EMPTY;
+                t.vertices().iter().for_each(|&v| b.grow(v));
+                b
+            })
+            .collect();
+        let centroids = bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect();
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        let mut builder = Builder {
+            bounds,
+            centroids,
+            indices: &mut order,
+            nodes: Vec::with_capacity(2 * triangles.len()),
+        };
+        builder.build(0, triangles.len(), 0);
+        let nodes = builder.nodes;
+        Bvh { nodes, order }
+    }
+}
+
+impl Builder<'_> {
+    fn range_bounds(&self, start: usize, end: usize) -> (Aabb, Aabb) {
+        let mut b = Aabb::EMPTY;
+        let mut c = Aabb::EMPTY;
+        for &i in &self.indices[start..end] {
+            b.merge(&self.bounds[i as usize]);
+            c.grow(self.centroids[i as usize]);
+        }
+        (b, c)
+    }
+
+    fn build(&mut self, start: usize, end: usize, depth: usize) -> usize {
+        let (bounds, centroid_bounds) = self.range_bounds(start, end);
+        let node_index = self.nodes.len();
+        self.nodes.push(BvhNode {
+            lo: bounds.lo.into(),
+            hi: bounds.hi.into(),
+            index: start as u32,
+            count: (end - start) as u32,
+        });
+        let count = end - start;
+        if count <= MAX_LEAF_TRIANGLES {
+            return node_index;
+        }
+        let split = if depth < SAH_MAX_DEPTH {
+            self.sah_split(start, end, &bounds, &centroid_bounds)
+        } else {
+            None
+        };
+        let mid = match split {
+            Some(mid) => mid,
+            None if count > MAX_LEAF_TRIANGLES * 4 || depth >= SAH_MAX_DEPTH => self.median_split(start, end, &centroid_bounds),
+            None => return node_index,
+        };
+        self.build(start, mid, depth + 1);
+        let right = self.build(mid, end, depth + 1);
+        self.nodes[node_index].index = right as u32;
+        self.nodes[node_index].count = 0;
+        node_index
+    }
+
+    /// Partitions by the cheapest of SAH_BINS bins per axis; `None` if a leaf is cheaper.
+    fn sah_split(&mut self, start: usize, end: usize, bounds: &Aabb, cb: &Aabb) -> Option<usize> {
+        let extent = cb.hi - cb.lo;
+        let mut best: Option<(f32, usize, usize)> = None;
+        for axis in 0..3 {
+            if !(extent[axis] > 0.0) {
+                continue;
+            }
+            let scale = SAH_BINS as f32 / extent[axis];
+            let bin_of = |c: Vec3| (((c[axis] - cb.lo[axis]) * scale) as usize).min(SAH_BINS - 1);
+            let mut bins = [(Aabb::EMPTY, 0usize); SAH_BINS];
+            for &i in &self.indices[start..end] {
+                let b = &mut bins[bin_of(self.centroids[i as usize])];
+                b.0.merge(&self.bounds[i as usize]);
+                b.1 += 1;
+            }
+            let mut right_cost = [0.0f32; SAH_BINS];
+            let (mut acc, mut n) = (Aabb::EMPTY, 0);
+            for k in (1..SAH_BINS).rev() {
+                acc.merge(&bins[k].0);
+                n += bins[k].1;
+                right_cost[k] = if n > 0 { acc.half_area() * n as f32 } else { 0.0 };
+            }
+            let (mut acc, mut n) = (Aabb::EMPTY, 0);
+            for k in 0..SAH_BINS - 1 {
+                acc.merge(&bins[k].0);
+                n += bins[k].1;
+                if n == 0 || n == end - start {
+                    continue;
+                }
+                let cost = acc.half_area() * n as f32 + right_cost[k + 1];
+                if best.map_or(true, |(c, _, _)| cost < c) {
+                    best = Some((cost, axis, k));
+                }
+            }
+        }
+        let (cost, axis, k) = best?;
+        // Traversal costs about one triangle test per node visit.
+        let leaf_cost = bounds.half_area() * (end - start) as f32;
+        if cost + bounds.half_area() >= leaf_cost && end - start <= MAX_LEAF_TRIANGLES * 4 {
+            return None;
+        }
+        let scale = SAH_BINS as f32 / extent[axis];
+        let (lo, centroids) = (cb.lo[axis], &self.centroids);
+        let slice = &mut self.indices[start..end];
+        let mut left = 0;
+        for j in 0..slice.len() {
+            let bin = (((centroids[slice[j] as usize][axis] - lo) * scale) as usize).min(SAH_BINS - 1);
+            if bin <= k {
+                slice.swap(left, j);
+                left += 1;
+            }
+        }
+        Some(start + left)
+    }
+
+    fn median_split(&mut self, start: usize, end: usize, cb: &Aabb) -> usize {
+        let axis = (cb.hi - cb.lo).max_position();
+        let centroids = &self.centroids;
+        let mid = (start + end) / 2;
+        self.indices[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
+        });
+        mid
+    }
+}
+
+/// Möller-Trumbore; hits with t in (0, tmax) count, from either side. Returns (t, (b1, b2)).
+pub fn intersect_triangle(o: Vec3, d: Vec3, tri: &Triangle, tmax: f32) -> Option<(f32, Vec2)> {
+    let (v0, e1, e2) = (Vec3::from(tri.v0), Vec3::from(tri.e1), Vec3::from(tri.e2));
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let s = o - v0;
+    let b1 = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&b1) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let b2 = d.dot(q) * inv_det;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv_det;
+    (t > 0.0 && t < tmax).then_some((t, Vec2::new(b1, b2)))
+}
+
+pub fn intersect_aabb(o: Vec3, inv_d: Vec3, lo: Vec3, hi: Vec3, tmax: f32) -> f32 {
+    let t0 = (lo - o) * inv_d;
+    let t1 = (hi - o) * inv_d;
+    let (tn, tf) = (t0.min(t1), t0.max(t1));
+    let enter = tn.x.max(tn.y).max(tn.z.max(0.0));
+    let leave = tf.x.min(tf.y).min(tf.z.min(tmax));
+    if enter <= leave {
+        enter
+    } else {
+        f32::INFINITY
+    }
+}
+
+pub fn safe_inverse(d: Vec3) -> Vec3 {
+    let inv = |x: f32| if x != 0.0 { 1.0 / x } else { 1e30 };
+    Vec3::new(inv(d.x), inv(d.y), inv(d.z))
+}
+
+/// Twin of GLSL `bvh_traverse`: closest hit, or the first hit found when `any_hit`.
+pub fn bvh_traverse(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3, tmax: f32, any_hit: bool) -> Hit {
+    let mut hit = Hit {
+        t: tmax,
+        triangle: NO_HIT,
+        bary: Vec2::ZERO,
+    };
+    let inv_d = safe_inverse(d);
+    let bounds = |i: usize| (Vec3::from(nodes[i].lo), Vec3::from(nodes[i].hi));
+    let (lo, hi) = bounds(0);
+    if intersect_aabb(o, inv_d, lo, hi, hit.t) == f32::INFINITY {
+        return hit;
+    }
+    let mut stack = [0usize; BVH_STACK_SIZE];
+    let mut sp = 0;
+    let mut node = 0usize;
+    loop {
+        let n = nodes[node];
+        if n.count > 0 {
+            for i in n.index..n.index + n.count {
+                if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t) {
+                    hit = Hit { t, triangle: i, bary };
+                    if any_hit {
+                        return hit;
+                    }
+                }
+            }
+        } else {
+            let (left, right) = (node + 1, n.index as usize);
+            let (llo, lhi) = bounds(left);
+            let (rlo, rhi) = bounds(right);
+            let tl = intersect_aabb(o, inv_d, llo, lhi, hit.t);
+            let tr = intersect_aabb(o, inv_d, rlo, rhi, hit.t);
+            let (hit_l, hit_r) = (tl != f32::INFINITY, tr != f32::INFINITY);
+            if hit_l && hit_r {
+                let (near, far) = if tl <= tr { (left, right) } else { (right, left) };
+                stack[sp] = far;
+                sp += 1;
+                node = near;
+                continue;
+            }
+            if hit_l || hit_r {
+                node = if hit_l { left } else { right };
+                continue;
+            }
+        }
+        if sp == 0 {
+            break;
+        }
+        sp -= 1;
+        node = stack[sp];
+    }
+    hit
+}
+
+pub fn trace_closest(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3, tmax: f32) -> Hit {
+    bvh_traverse(nodes, triangles, o, d, tmax, false)
+}
+
+pub fn trace_occluded(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3, tmax: f32) -> bool {
+    bvh_traverse(nodes, triangles, o, d, tmax, true).triangle != NO_HIT
+}
+
+/// Twin of GLSL `offset_ray_origin` (Wächter and Binder, Ray Tracing Gems ch. 6).
+pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let mut out = p;
+    for k in 0..3 {
+        let of_i = (INT_SCALE * n[k]) as i32;
+        let shifted = f32::from_bits((p[k].to_bits() as i32).wrapping_add(if p[k] < 0.0 { -of_i } else { of_i }) as u32);
+        out[k] = if p[k].abs() < ORIGIN { p[k] + FLOAT_SCALE * n[k] } else { shifted };
+    }
+    out
+}

@@ -1,0 +1,64 @@
+//! The commands behind the CLI; main.rs only parses arguments into these structs.
+
+mod bench;
+mod info;
+mod render;
+
+pub use bench::{bench, BenchArgs};
+pub use info::info;
+pub use render::{render, RenderArgs};
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use anyhow::Result;
+
+use crate::scene::{load_scene, Scene};
+use crate::vk::{Context, ContextOptions};
+
+pub const DEFAULT_SCENE: &str = "scenes/cornell.gltf";
+
+#[derive(Debug, Clone, Default)]
+pub struct DeviceArgs {
+    pub device: Option<String>,
+    pub validate: bool,
+}
+
+/// The scene to load: the given path, or the bundled Cornell box next to the crate.
+pub fn scene_path(scene: Option<&Path>) -> PathBuf {
+    match scene {
+        Some(p) => p.to_path_buf(),
+        None => {
+            let local = PathBuf::from(DEFAULT_SCENE);
+            if local.exists() {
+                local
+            } else {
+                Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_SCENE)
+            }
+        }
+    }
+}
+
+/// Loads a scene and prints the loader's warnings to stderr.
+pub fn load_with_warnings(path: &Path) -> Result<Scene> {
+    let scene = load_scene(path)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}
+
+pub fn open_device(args: &DeviceArgs) -> Result<Arc<Context>> {
+    let ctx = Context::new(&ContextOptions {
+        device: args.device.clone(),
+        validation: args.validate,
+    })?;
+    eprintln!("device: {} ({:?})", ctx.info.name, ctx.info.device_type);
+    Ok(Arc::new(ctx))
+}
+
+/// Fails the command if the validation layer reported anything.
+pub fn finish_device(ctx: &Context) -> Result<()> {
+    ctx.check_validation()?;
+    Ok(())
+}

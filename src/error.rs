@@ -1,0 +1,30 @@
+//! Typed errors for failures a caller may want to tell apart (device loss, out-of-memory, limits).
+//! Everything else travels as `anyhow::Error` with context added at the boundary.
+
+use ash::vk;
+
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("the Vulkan device was lost (VK_ERROR_DEVICE_LOST) during {during}; the GPU work was abandoned")]
+    DeviceLost { during: &'static str },
+    #[error("out of GPU memory while allocating {what} ({bytes} bytes)")]
+    OutOfMemory { what: String, bytes: u64 },
+    #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per storage-buffer binding (maxStorageBufferRange)")]
+    BindingTooLarge { what: String, needed: u64, limit: u64 },
+    #[error("Vulkan call failed during {during}: {result:?}")]
+    Vulkan { during: &'static str, result: vk::Result },
+    #[error("{count} Vulkan validation error(s) were reported; first: {first}")]
+    Validation { count: u32, first: String },
+}
+
+/// Maps a raw Vulkan result to a typed error, keeping device loss and OOM distinguishable.
+pub fn vk_error(during: &'static str) -> impl FnOnce(vk::Result) -> GpuError {
+    move |result| match result {
+        vk::Result::ERROR_DEVICE_LOST => GpuError::DeviceLost { during },
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => GpuError::OutOfMemory {
+            what: during.to_string(),
+            bytes: 0,
+        },
+        result => GpuError::Vulkan { during, result },
+    }
+}

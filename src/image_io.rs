@@ -1,0 +1,58 @@
+//! Image files: linear float RGB EXR (mean and variance) and a tonemapped sRGB PNG preview.
+
+use std::path::Path;
+
+use anyhow::{anyhow, Context as _, Result};
+use glam::Vec3;
+
+use crate::render::Image;
+
+pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<()> {
+    let (w, h) = (width as usize, height as usize);
+    exr::prelude::write_rgb_file(path, w, h, |x, y| {
+        let p = pixels[y * w + x];
+        (p.x, p.y, p.z)
+    })
+    .map_err(|e| anyhow!("{}: cannot write EXR: {e}", path.display()))
+}
+
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| (resolution.width(), vec![Vec3::ZERO; resolution.width() * resolution.height()]),
+        |(w, pixels): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            pixels[pos.y() * *w + pos.x()] = Vec3::new(r, g, b)
+        },
+    )
+    .map_err(|e| anyhow!("{}: cannot read EXR: {e}", path.display()))?;
+    let size = image.layer_data.size;
+    Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
+}
+
+fn srgb_encode(linear: f32) -> u8 {
+    let c = linear.clamp(0.0, 1.0);
+    let s = if c <= 0.0031308 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// A preview: linear radiance clamped to [0, 1] and sRGB-encoded (no exposure change).
+pub fn write_png(path: &Path, image: &Image) -> Result<()> {
+    let file = std::fs::File::create(path).with_context(|| format!("{}: cannot create PNG", path.display()))?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), image.width, image.height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let data: Vec<u8> = image
+        .mean
+        .iter()
+        .flat_map(|p| [srgb_encode(p.x), srgb_encode(p.y), srgb_encode(p.z)])
+        .collect();
+    encoder
+        .write_header()
+        .and_then(|mut w| w.write_image_data(&data))
+        .map_err(|e| anyhow!("{}: cannot write PNG: {e}", path.display()))
+}

@@ -1,0 +1,17 @@
+//! restir-pt: a Vulkan compute path tracer with ReSTIR PT reuse through explicit shift mappings.
+//! Every GLSL function an oracle mirrors has a Rust twin of the same name in the matching module.
+
+pub mod bsdf;
+pub mod bundled_scenes;
+pub mod bvh;
+pub mod cli;
+pub mod error;
+pub mod gltf_writer;
+pub mod gpu_types;
+pub mod image_io;
+pub mod lights;
+pub mod render;
+pub mod rng;
+pub mod sampling;
+pub mod scene;
+pub mod vk;

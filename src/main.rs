@@ -1,0 +1,150 @@
+//! Command-line parsing only; the commands live in `restir_pt::cli`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+use restir_pt::cli::{self, DeviceArgs, RenderArgs};
+
+#[derive(Parser)]
+#[command(
+    name = "restir-pt",
+    version,
+    about = "A Vulkan compute ReSTIR path tracer with explicit shift mappings"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG.
+    Render(RenderCmd),
+    /// Print a scene's triangles, emitters, materials, bounds and cameras.
+    Info { scene: PathBuf },
+    /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
+    Bench(BenchCmd),
+}
+
+#[derive(Args)]
+struct DeviceOpts {
+    /// Vulkan device to use: a name substring or an index (the chosen device is printed).
+    #[arg(long, value_name = "NAME|INDEX")]
+    device: Option<String>,
+    /// Enable the Vulkan validation layer (always on in debug builds); any message fails the run.
+    #[arg(long)]
+    validate: bool,
+}
+
+#[derive(Args)]
+struct RenderCmd {
+    /// glTF 2.0 scene (.gltf or .glb); defaults to the bundled Cornell box.
+    scene: Option<PathBuf>,
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    /// Maximum number of path segments: 1 shows only directly visible emitters, 2 adds direct
+    /// lighting, each further step adds one bounce of indirect light.
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// Glossy/diffuse Russian roulette from the third segment on (off by default).
+    #[arg(long)]
+    russian_roulette: bool,
+    /// Index of the glTF camera to render from (scene order).
+    #[arg(long, default_value_t = 0)]
+    camera: usize,
+    /// Linear float RGB EXR output (default: out/<scene>.exr).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Tonemapped sRGB PNG preview (default: next to the EXR).
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Also write the per-pixel variance of the estimate as an EXR.
+    #[arg(long)]
+    variance: Option<PathBuf>,
+    /// Write the summary as JSON.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    #[command(flatten)]
+    device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct BenchCmd {
+    scene: Option<PathBuf>,
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    #[arg(long, default_value_t = 16)]
+    spp: u32,
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    /// Timed runs after one warm-up run.
+    #[arg(long, default_value_t = 5)]
+    runs: u32,
+    #[arg(long)]
+    report: Option<PathBuf>,
+    #[command(flatten)]
+    device: DeviceOpts,
+}
+
+impl From<DeviceOpts> for DeviceArgs {
+    fn from(d: DeviceOpts) -> Self {
+        DeviceArgs {
+            device: d.device,
+            validate: d.validate || cfg!(debug_assertions),
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let command = match cli.command {
+        Some(c) => c,
+        None => Cli::parse_from(["restir-pt", "render"])
+            .command
+            .expect("render parses with defaults"),
+    };
+    let result = match command {
+        Command::Render(r) => cli::render(RenderArgs {
+            scene: r.scene,
+            spp: r.spp,
+            width: r.width,
+            height: r.height,
+            max_depth: r.max_depth,
+            seed: r.seed,
+            russian_roulette: r.russian_roulette,
+            camera: r.camera,
+            out: r.out,
+            png: r.png,
+            variance: r.variance,
+            report: r.report,
+            device: r.device.into(),
+        }),
+        Command::Info { scene } => cli::info(&scene),
+        Command::Bench(b) => cli::bench(cli::BenchArgs {
+            scene: b.scene,
+            width: b.width,
+            height: b.height,
+            spp: b.spp,
+            max_depth: b.max_depth,
+            runs: b.runs,
+            report: b.report,
+            device: b.device.into(),
+        }),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

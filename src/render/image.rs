@@ -1,0 +1,50 @@
+//! A linear RGB float image with per-pixel variance of the mean.
+
+use glam::Vec3;
+
+#[derive(Debug, Clone)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub mean: Vec<Vec3>,
+    /// Variance of the pixel estimate (the sample variance divided by the sample count).
+    pub variance: Vec<Vec3>,
+}
+
+impl Image {
+    /// From per-pixel sums of L (rgb) and counts (w), and sums of L^2.
+    pub fn from_sums(width: u32, height: u32, sums: &[[f32; 4]], sums_sq: &[[f32; 4]]) -> Image {
+        let mut mean = Vec::with_capacity(sums.len());
+        let mut variance = Vec::with_capacity(sums.len());
+        for (s, q) in sums.iter().zip(sums_sq) {
+            let n = s[3].max(1.0);
+            let m = Vec3::new(s[0], s[1], s[2]) / n;
+            let m2 = Vec3::new(q[0], q[1], q[2]) / n;
+            let sample_var = if n > 1.0 {
+                (m2 - m * m).max(Vec3::ZERO) * (n / (n - 1.0))
+            } else {
+                Vec3::ZERO
+            };
+            mean.push(m);
+            variance.push(sample_var / n);
+        }
+        Image {
+            width,
+            height,
+            mean,
+            variance,
+        }
+    }
+
+    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
+        self.mean[(y * self.width + x) as usize]
+    }
+
+    pub fn non_finite_count(&self) -> usize {
+        self.mean.iter().filter(|p| !p.is_finite()).count()
+    }
+
+    pub fn average(&self) -> Vec3 {
+        self.mean.iter().fold(Vec3::ZERO, |a, &p| a + p) / self.mean.len() as f32
+    }
+}

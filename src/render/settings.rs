@@ -1,0 +1,82 @@
+//! What a render is asked to do, validated before any GPU allocation.
+
+use anyhow::{bail, Result};
+
+use crate::gpu_types::{FrameParams, FLAG_RUSSIAN_ROULETTE};
+use crate::scene::Scene;
+
+/// Sides beyond this are refused: per-pixel indices are u32 and workgroup counts are bounded.
+pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+#[derive(Debug, Clone)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub seed: u32,
+    pub russian_roulette: bool,
+    pub camera: usize,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 256,
+            height: 256,
+            spp: 64,
+            max_depth: 8,
+            seed: 0,
+            russian_roulette: false,
+            camera: 0,
+        }
+    }
+}
+
+impl RenderSettings {
+    pub fn validate(&self, scene: &Scene) -> Result<()> {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 {
+            bail!("resolution {w}x{h} is empty: width and height must be at least 1");
+        }
+        if w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE || w as u64 * h as u64 > MAX_PIXELS {
+            bail!("resolution {w}x{h} is too large: at most {MAX_IMAGE_SIDE} per side and {MAX_PIXELS} pixels");
+        }
+        if self.spp == 0 {
+            bail!("--spp must be at least 1");
+        }
+        if self.max_depth == 0 {
+            bail!("--max-depth must be at least 1 (1 shows only directly visible emitters)");
+        }
+        if self.camera >= scene.cameras.len() {
+            bail!(
+                "{}: --camera {} does not exist; the scene has {} camera(s)",
+                scene.source.display(),
+                self.camera,
+                scene.cameras.len()
+            );
+        }
+        Ok(())
+    }
+
+    pub fn pixel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// The frame parameters for this render, before the per-dispatch sample range is set.
+    pub fn frame_params(&self, scene: &Scene) -> FrameParams {
+        let mut params = FrameParams {
+            scene_env: scene.environment.extend(scene.env_select_prob).into(),
+            width: self.width,
+            height: self.height,
+            max_depth: self.max_depth,
+            render_seed: self.seed,
+            flags: if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 },
+            emitter_count: scene.emitters.len() as u32,
+            ..Default::default()
+        };
+        scene.cameras[self.camera].fill_params(&mut params, self.width, self.height);
+        params
+    }
+}

@@ -1,0 +1,80 @@
+//! Warping uniforms to directions and points; the twin of glsl/sampling.glsl.
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+pub const INV_PI: f32 = 1.0 / PI;
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Orthonormal basis around a unit normal without branches on its sign (Duff et al., JCGT 2017).
+pub fn build_onb(n: Vec3) -> (Vec3, Vec3) {
+    let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (s + n.z);
+    let c = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + s * n.x * n.x * a, s * c, -s * n.x),
+        Vec3::new(c, s + n.y * n.y * a, -n.y),
+    )
+}
+
+pub fn to_local(v: Vec3, t: Vec3, b: Vec3, n: Vec3) -> Vec3 {
+    Vec3::new(v.dot(t), v.dot(b), v.dot(n))
+}
+
+pub fn to_world(v: Vec3, t: Vec3, b: Vec3, n: Vec3) -> Vec3 {
+    v.x * t + v.y * b + v.z * n
+}
+
+pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, phi) = if o.x.abs() > o.y.abs() {
+        (o.x, (PI / 4.0) * (o.y / o.x))
+    } else {
+        (o.y, PI / 2.0 - (PI / 4.0) * (o.x / o.y))
+    };
+    r * Vec2::new(phi.cos(), phi.sin())
+}
+
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = sample_concentric_disk(u);
+    Vec3::new(d.x, d.y, (1.0 - d.dot(d)).max(0.0).sqrt())
+}
+
+pub fn pdf_cosine_hemisphere(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) * INV_PI
+}
+
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Barycentrics (b1, b2) uniform over a triangle; b0 = 1 - b1 - b2.
+pub fn sample_triangle(u: Vec2) -> Vec2 {
+    let su = u.x.sqrt();
+    Vec2::new(1.0 - su, u.y * su)
+}
+
+/// GGX visible-normal sampling by spherical caps (Dupuy and Benyoub 2023); wo.z >= 0 locally.
+pub fn sample_ggx_vndf(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+    let wo_std = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
+    let phi = 2.0 * PI * u.x;
+    let z = (1.0 - u.y) * (1.0 + wo_std.z) - wo_std.z;
+    let sin_theta = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
+    let h_std = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), z) + wo_std;
+    Vec3::new(alpha * h_std.x, alpha * h_std.y, h_std.z.max(0.0)).normalize()
+}
+
+pub fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 {
+        a2 / (a2 + b2)
+    } else {
+        0.0
+    }
+}

@@ -1,0 +1,163 @@
+//! Storage and uniform buffers allocated through gpu-allocator and freed on drop.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+use super::Context;
+use crate::error::{vk_error, GpuError};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BufferUsage {
+    /// Read or written by kernels; lives in device memory, reached by staging copies.
+    Storage,
+    /// Small inputs rewritten from the host between dispatches; host-visible.
+    Uniform,
+    /// Staging memory the host maps for uploads and readbacks.
+    Staging,
+}
+
+pub struct Buffer {
+    pub handle: vk::Buffer,
+    pub size: u64,
+    allocation: Option<Allocation>,
+    ctx: Arc<Context>,
+}
+
+impl Buffer {
+    pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: BufferUsage) -> Result<Self, GpuError> {
+        // Zero-sized buffers are illegal in Vulkan; empty arrays still get a valid binding.
+        let size = size.max(16);
+        if usage == BufferUsage::Storage {
+            ctx.check_binding_size(name, size)?;
+        }
+        let (flags, location) = match usage {
+            BufferUsage::Storage => (
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            ),
+            BufferUsage::Uniform => (vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu),
+            BufferUsage::Staging => (
+                vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            ),
+        };
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(flags)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let handle = unsafe { ctx.device.create_buffer(&info, None) }.map_err(vk_error("creating a buffer"))?;
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(handle) };
+        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_buffer(handle, None) };
+                return Err(match e {
+                    gpu_allocator::AllocationError::OutOfMemory => GpuError::OutOfMemory {
+                        what: name.to_string(),
+                        bytes: size,
+                    },
+                    other => GpuError::OutOfMemory {
+                        what: format!("{name} ({other})"),
+                        bytes: size,
+                    },
+                });
+            }
+        };
+        if let Err(e) = unsafe { ctx.device.bind_buffer_memory(handle, allocation.memory(), allocation.offset()) } {
+            // Dropping the partly built buffer frees both halves.
+            drop(Buffer {
+                handle,
+                size,
+                allocation: Some(allocation),
+                ctx: ctx.clone(),
+            });
+            return Err(vk_error("binding buffer memory")(e));
+        }
+        Ok(Self {
+            handle,
+            size,
+            allocation: Some(allocation),
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// Creates a storage buffer holding `data`.
+    pub fn from_slice<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T]) -> Result<Self, GpuError> {
+        let buffer = Self::new(ctx, name, std::mem::size_of_val(data) as u64, BufferUsage::Storage)?;
+        buffer.write(data)?;
+        Ok(buffer)
+    }
+
+    fn mapped(&self) -> Option<&[u8]> {
+        self.allocation.as_ref().and_then(|a| a.mapped_slice())
+    }
+
+    /// Writes `data` at offset 0, directly when mapped, through a staging copy otherwise.
+    pub fn write<T: bytemuck::Pod>(&self, data: &[T]) -> Result<(), GpuError> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        assert!(
+            bytes.len() as u64 <= self.size,
+            "write of {} bytes into a {}-byte buffer",
+            bytes.len(),
+            self.size
+        );
+        if bytes.is_empty() {
+            return Ok(());
+        }
+        if let Some(ptr) = self.allocation.as_ref().and_then(|a| a.mapped_ptr()) {
+            unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.as_ptr() as *mut u8, bytes.len()) };
+            return Ok(());
+        }
+        let staging = Buffer::new(&self.ctx, "staging upload", bytes.len() as u64, BufferUsage::Staging)?;
+        staging.write(bytes)?;
+        self.ctx.submit_and_wait(|cmd| unsafe {
+            let region = [vk::BufferCopy::default().size(bytes.len() as u64)];
+            self.ctx.device.cmd_copy_buffer(cmd, staging.handle, self.handle, &region);
+        })
+    }
+
+    /// Reads the first `count` elements back to the host.
+    pub fn read<T: bytemuck::Pod>(&self, count: usize) -> Result<Vec<T>, GpuError> {
+        let bytes = (count * std::mem::size_of::<T>()) as u64;
+        assert!(bytes <= self.size, "read of {bytes} bytes from a {}-byte buffer", self.size);
+        if let Some(mapped) = self.mapped() {
+            return Ok(bytemuck::pod_collect_to_vec(&mapped[..bytes as usize]));
+        }
+        let staging = Buffer::new(&self.ctx, "staging readback", bytes, BufferUsage::Staging)?;
+        self.ctx.submit_and_wait(|cmd| unsafe {
+            let region = [vk::BufferCopy::default().size(bytes)];
+            self.ctx.device.cmd_copy_buffer(cmd, self.handle, staging.handle, &region);
+        })?;
+        staging.read(count)
+    }
+
+    /// Records a fill of the whole buffer with one 32-bit pattern (e.g. NaN bits or zero).
+    pub fn record_fill(&self, cmd: vk::CommandBuffer, pattern: u32) {
+        unsafe { self.ctx.device.cmd_fill_buffer(cmd, self.handle, 0, vk::WHOLE_SIZE, pattern) };
+    }
+
+    /// Fills the whole buffer with one 32-bit pattern and waits.
+    pub fn fill(&self, pattern: u32) -> Result<(), GpuError> {
+        self.ctx.submit_and_wait(|cmd| self.record_fill(cmd, pattern))
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        unsafe { self.ctx.device.destroy_buffer(self.handle, None) };
+        if let Some(allocation) = self.allocation.take() {
+            // Freeing only fails for foreign allocations, which this type never holds.
+            let _ = self.ctx.allocator().free(allocation);
+        }
+    }
+}

@@ -1,0 +1,193 @@
+//! A compute pipeline with one descriptor set of buffers and an optional push-constant block.
+
+use std::sync::Arc;
+
+use anyhow::{Context as _, Result};
+use ash::vk;
+
+use super::{compile_kernel, Buffer, Context};
+use crate::error::{vk_error, GpuError};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    Uniform,
+    Storage,
+}
+
+impl Binding {
+    fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            Binding::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+            Binding::Storage => vk::DescriptorType::STORAGE_BUFFER,
+        }
+    }
+}
+
+pub struct Kernel {
+    pub name: String,
+    bindings: Vec<Binding>,
+    push_bytes: u32,
+    pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+    module: vk::ShaderModule,
+    ctx: Arc<Context>,
+}
+
+impl Kernel {
+    /// Builds the kernel glsl/`name` whose set 0 has `bindings` at indices 0..n.
+    pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], bindings: &[Binding], push_bytes: u32) -> Result<Self> {
+        let spirv = compile_kernel(name, defines)?;
+        Self::from_spirv(ctx, name, &spirv, bindings, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))
+    }
+
+    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], bindings: &[Binding], push_bytes: u32) -> Result<Self, GpuError> {
+        let device = &ctx.device;
+        // Each handle is owned by `kernel` as soon as it exists, so an early return frees it.
+        let mut kernel = Kernel {
+            name: name.to_string(),
+            bindings: bindings.to_vec(),
+            push_bytes,
+            pipeline: vk::Pipeline::null(),
+            layout: vk::PipelineLayout::null(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+            module: vk::ShaderModule::null(),
+            ctx: ctx.clone(),
+        };
+        let module_info = vk::ShaderModuleCreateInfo::default().code(spirv);
+        kernel.module = unsafe { device.create_shader_module(&module_info, None) }.map_err(vk_error("creating a shader module"))?;
+        let layout_bindings: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(b.descriptor_type())
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        let set_layout_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
+        kernel.set_layout =
+            unsafe { device.create_descriptor_set_layout(&set_layout_info, None) }.map_err(vk_error("creating a descriptor set layout"))?;
+        let set_layouts = [kernel.set_layout];
+        let ranges = [vk::PushConstantRange::default()
+            .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            .size(push_bytes)];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+        if push_bytes > 0 {
+            layout_info = layout_info.push_constant_ranges(&ranges);
+        }
+        kernel.layout = unsafe { device.create_pipeline_layout(&layout_info, None) }.map_err(vk_error("creating a pipeline layout"))?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(kernel.module)
+            .name(c"main");
+        let pipeline_info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(kernel.layout)];
+        kernel.pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &pipeline_info, None) }
+            .map_err(|(_, e)| vk_error("creating a compute pipeline")(e))?[0];
+
+        let mut sizes = Vec::new();
+        for kind in [Binding::Uniform, Binding::Storage] {
+            let count = bindings.iter().filter(|&&b| b == kind).count() as u32;
+            if count > 0 {
+                sizes.push(vk::DescriptorPoolSize::default().ty(kind.descriptor_type()).descriptor_count(count));
+            }
+        }
+        let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
+        kernel.pool = unsafe { device.create_descriptor_pool(&pool_info, None) }.map_err(vk_error("creating a descriptor pool"))?;
+        let alloc_info = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(kernel.pool)
+            .set_layouts(&set_layouts);
+        kernel.set = unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_error("allocating a descriptor set"))?[0];
+        Ok(kernel)
+    }
+
+    /// Points binding i at `buffers[i]`; the caller keeps the buffers alive while dispatching.
+    pub fn bind(&self, buffers: &[&Buffer]) {
+        assert_eq!(
+            buffers.len(),
+            self.bindings.len(),
+            "kernel {} takes {} bindings",
+            self.name,
+            self.bindings.len()
+        );
+        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+            .iter()
+            .map(|b| [vk::DescriptorBufferInfo::default().buffer(b.handle).offset(0).range(vk::WHOLE_SIZE)])
+            .collect();
+        let writes: Vec<_> = infos
+            .iter()
+            .enumerate()
+            .map(|(i, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(self.bindings[i].descriptor_type())
+                    .buffer_info(info)
+            })
+            .collect();
+        unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };
+    }
+
+    /// Records a dispatch of `groups` workgroups with `push` as the push-constant block.
+    pub fn record_dispatch(&self, cmd: vk::CommandBuffer, groups: [u32; 3], push: &[u8]) {
+        assert_eq!(
+            push.len() as u32,
+            self.push_bytes,
+            "kernel {} takes {} push-constant bytes",
+            self.name,
+            self.push_bytes
+        );
+        let device = &self.ctx.device;
+        unsafe {
+            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.set], &[]);
+            if !push.is_empty() {
+                device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+            }
+            device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]);
+        }
+    }
+
+    /// Dispatches once over `count` invocations in 1D groups of `local_size` and waits.
+    pub fn run_1d(&self, count: u32, local_size: u32, push: &[u8]) -> Result<(), GpuError> {
+        self.ctx
+            .submit_and_wait(|cmd| self.record_dispatch(cmd, [count.div_ceil(local_size), 1, 1], push))
+    }
+}
+
+/// Makes the writes of one dispatch (and transfers) visible to the next.
+pub fn record_compute_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ)];
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+            vk::DependencyFlags::empty(),
+            &barrier,
+            &[],
+            &[],
+        )
+    };
+}
+
+impl Drop for Kernel {
+    fn drop(&mut self) {
+        let device = &self.ctx.device;
+        unsafe {
+            device.destroy_pipeline(self.pipeline, None);
+            device.destroy_pipeline_layout(self.layout, None);
+            device.destroy_descriptor_pool(self.pool, None);
+            device.destroy_descriptor_set_layout(self.set_layout, None);
+            device.destroy_shader_module(self.module, None);
+        }
+    }
+}

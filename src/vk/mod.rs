@@ -1,0 +1,13 @@
+//! The thin Vulkan layer: instance/device selection, buffers, compute kernels and timing.
+
+mod buffer;
+mod context;
+mod kernel;
+mod shader;
+mod timer;
+
+pub use buffer::{Buffer, BufferUsage};
+pub use context::{Context, ContextOptions, DeviceInfo};
+pub use kernel::{record_compute_barrier, Binding, Kernel};
+pub use shader::{compile_kernel, glsl_source, GLSL_SOURCES};
+pub use timer::PassTimer;

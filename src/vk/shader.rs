@@ -1,0 +1,66 @@
+//! GLSL to SPIR-V with shaderc (glslang), resolving `#include` against the embedded glsl/ tree.
+
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
+
+use anyhow::{anyhow, Result};
+
+/// Every file under glsl/, keyed by its path relative to glsl/.
+pub static GLSL_SOURCES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/glsl_sources.rs"));
+
+pub fn glsl_source(name: &str) -> Option<&'static str> {
+    GLSL_SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
+}
+
+fn resolve_include(requested: &str, kind: shaderc::IncludeType, requester: &str) -> Option<(String, &'static str)> {
+    let relative = match (kind, requester.rsplit_once('/')) {
+        (shaderc::IncludeType::Relative, Some((dir, _))) => format!("{dir}/{requested}"),
+        _ => requested.to_string(),
+    };
+    // Includes written relative to a subfolder may still name a top-level file.
+    [relative, requested.to_string()]
+        .into_iter()
+        .find_map(|name| glsl_source(&name).map(|s| (name, s)))
+}
+
+type CacheKey = (String, Vec<(String, String)>);
+
+/// Compiles the compute kernel `name` (a path under glsl/) with the given `#define`s.
+/// Results are cached for the process: tests build the same kernels many times.
+pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
+    static CACHE: OnceLock<Mutex<HashMap<CacheKey, Vec<u32>>>> = OnceLock::new();
+    let key = (
+        name.to_string(),
+        defines.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect::<Vec<_>>(),
+    );
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(spirv) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+        return Ok(spirv);
+    }
+    let source = glsl_source(name).ok_or_else(|| anyhow!("no GLSL kernel named {name} under glsl/"))?;
+    let compiler = shaderc::Compiler::new().map_err(|e| anyhow!("cannot initialise shaderc: {e}"))?;
+    let mut options = shaderc::CompileOptions::new().map_err(|e| anyhow!("cannot create shaderc options: {e}"))?;
+    options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+    options.set_target_spirv(shaderc::SpirvVersion::V1_5);
+    options.set_optimization_level(shaderc::OptimizationLevel::Performance);
+    options.set_generate_debug_info();
+    for (k, v) in defines {
+        options.add_macro_definition(k, Some(v));
+    }
+    options.set_include_callback(|requested, kind, requester, _depth| {
+        resolve_include(requested, kind, requester)
+            .map(|(resolved_name, content)| shaderc::ResolvedInclude {
+                resolved_name,
+                content: content.to_string(),
+            })
+            .ok_or_else(|| format!("{requester}: cannot find include {requested:?} under glsl/"))
+    });
+    let artifact = compiler
+        .compile_into_spirv(source, shaderc::ShaderKind::Compute, name, "main", Some(&options))
+        .map_err(|e| anyhow!("GLSL compilation of {name} failed:\n{e}"))?;
+    let spirv = artifact.as_binary().to_vec();
+    if let Ok(mut c) = cache.lock() {
+        c.insert(key, spirv.clone());
+    }
+    Ok(spirv)
+}

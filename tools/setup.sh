@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs every system package restir-pt needs on Debian/Ubuntu: lavapipe (Mesa's CPU Vulkan
+# driver), the Vulkan loader and validation layer, and the static glslang/shaderc/SPIRV-Tools
+# archives that .cargo/config.toml links. Idempotent and non-interactive; runs as root or via sudo.
+set -euo pipefail
+
+packages=(
+  mesa-vulkan-drivers libvulkan1 vulkan-validationlayers vulkan-tools
+  glslang-tools glslang-dev spirv-tools libshaderc-dev
+  build-essential pkg-config
+)
+
+if [ "$(id -u)" -eq 0 ]; then
+  sudo=()
+else
+  command -v sudo >/dev/null || { echo "tools/setup.sh: needs root or sudo to install packages" >&2; exit 1; }
+  sudo=(sudo)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ "${#missing[@]}" -gt 0 ]; then
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+command -v cargo >/dev/null || { echo "tools/setup.sh: cargo not found; install Rust (rustup) first" >&2; exit 1; }
+echo "tools/setup.sh: system packages present (${#packages[@]} checked, ${#missing[@]} installed)"
