@@ -7,6 +7,18 @@
 #include "sampling.glsl"
 #include "types.glsl"
 
+// Kernels are specialised to the lobes a scene uses (lavapipe executes both sides of a divergent
+// branch, so unused lobes would cost time); each defaults to on, as in the oracle kernels.
+#ifndef BSDF_DIFFUSE
+#define BSDF_DIFFUSE 1
+#endif
+#ifndef BSDF_CONDUCTOR
+#define BSDF_CONDUCTOR 1
+#endif
+#ifndef BSDF_DIELECTRIC
+#define BSDF_DIELECTRIC 1
+#endif
+
 // Below this alpha (roughness 0.01) a lobe is treated as a perfect (delta) specular.
 const float DELTA_ALPHA = 1e-4;
 
@@ -132,17 +144,17 @@ void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float
     vec3 wo_s = wo * vec3(1.0, 1.0, side);
     vec3 wi_s = wi * vec3(1.0, 1.0, side);
     bool same_side = wo_s.z > 0.0 && wi_s.z > 0.0;
-    if (w_d > 0.0 && same_side) {
+    if (BSDF_DIFFUSE != 0 && w_d > 0.0 && same_side) {
         f_cos += w_d * m.base_color * INV_PI * wi_s.z;
         pdf += w_d * pdf_cosine_hemisphere(wi_s.z);
     }
-    if (w_c > 0.0 && same_side && alpha >= DELTA_ALPHA) {
+    if (BSDF_CONDUCTOR != 0 && w_c > 0.0 && same_side && alpha >= DELTA_ALPHA) {
         vec3 h = normalize(wo_s + wi_s);
         vec3 f = fresnel_schlick(m.base_color, dot(wo_s, h));
         f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
         pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
     }
-    if (w_t > 0.0 && alpha >= DELTA_ALPHA) {
+    if (BSDF_DIELECTRIC != 0 && w_t > 0.0 && alpha >= DELTA_ALPHA) {
         float fc, p;
         dielectric_eval_pdf(wo, wi, alpha, m.ior, fc, p);
         f_cos += w_t * m.base_color * fc;
@@ -150,22 +162,13 @@ void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float
     }
 }
 
-vec3 bsdf_eval(Material m, vec3 n, vec3 wo, vec3 wi) {
+// f * |cos_i| of the non-delta lobes, and in `pdf` the solid-angle pdf of bsdf_sample producing wi.
+vec3 bsdf_eval_pdf(Material m, vec3 n, vec3 wo, vec3 wi, out float pdf) {
     vec3 t, b;
     build_onb(n, t, b);
     vec3 f_cos;
-    float pdf;
     bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n), f_cos, pdf);
     return f_cos;
-}
-
-float bsdf_pdf(Material m, vec3 n, vec3 wo, vec3 wi) {
-    vec3 t, b;
-    build_onb(n, t, b);
-    vec3 f_cos;
-    float pdf;
-    bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n), f_cos, pdf);
-    return pdf;
 }
 
 // u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
@@ -186,10 +189,10 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
     vec3 wo_s = wo * vec3(1.0, 1.0, side);
     vec3 wi;
     uint lobe;
-    if (u.z < w_d) {
+    if (BSDF_DIFFUSE != 0 && u.z < w_d) {
         wi = sample_cosine_hemisphere(u.xy) * vec3(1.0, 1.0, side);
         lobe = LOBE_DIFFUSE;
-    } else if (u.z < w_d + w_c) {
+    } else if (BSDF_CONDUCTOR != 0 && u.z < w_d + w_c) {
         lobe = LOBE_CONDUCTOR;
         if (alpha < DELTA_ALPHA) {
             s.wi = to_world(vec3(-wo.x, -wo.y, wo.z), t, b, n);
@@ -200,9 +203,8 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
         }
         vec3 h = sample_ggx_vndf(wo_s, alpha, u.xy);
         wi = reflect(-wo_s, h) * vec3(1.0, 1.0, side);
-    } else {
+    } else if (BSDF_DIELECTRIC != 0 && w_t > 0.0) {
         lobe = LOBE_DIELECTRIC;
-        if (w_t <= 0.0) return s;
         if (alpha < DELTA_ALPHA) {
             float fr = fresnel_dielectric(wo.z, m.ior);
             if (u.w < fr) {
@@ -231,6 +233,8 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
             if (!refract_dir(wo, wm, m.ior, wi, etap)) return s;
             lobe |= LOBE_TRANSMISSION;
         }
+    } else {
+        return s;
     }
     vec3 f_cos;
     float pdf;

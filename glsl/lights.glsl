@@ -7,6 +7,15 @@
 #include "sampling.glsl"
 #include "types.glsl"
 
+// Specialisation like the BSDF lobes: a scene without an environment or without emissive
+// triangles compiles that half of NEE out. Both default to on.
+#ifndef SCENE_ENVIRONMENT
+#define SCENE_ENVIRONMENT 1
+#endif
+#ifndef SCENE_EMITTERS
+#define SCENE_EMITTERS 1
+#endif
+
 struct LightSample {
     vec3 dir;        // unit direction from the shading point towards the light
     float dist;      // distance to the light point; +inf for the environment
@@ -55,14 +64,14 @@ LightSample sample_light(vec3 p, vec3 u) {
     ls.radiance = vec3(0.0);
     ls.pdf = 0.0;
     float p_env = env_select_prob();
-    if (u.x < p_env) {
+    if (SCENE_ENVIRONMENT != 0 && u.x < p_env) {
         ls.dir = sample_uniform_sphere(u.yz);
         ls.dist = 1.0 / 0.0;
         ls.radiance = scene_env.rgb;
         ls.pdf = environment_pdf();
         return ls;
     }
-    if (emitter_count == 0u) return ls;
+    if (SCENE_EMITTERS == 0 || emitter_count == 0u) return ls;
     float u_select = (u.x - p_env) / (1.0 - p_env);
     Emitter e = emitters[alias_select(min(u_select, 0.99999994), emitter_count)];
     Triangle tri = triangles[e.triangle];

@@ -1,4 +1,6 @@
-// Unidirectional path tracing with NEE and BSDF sampling combined by the power heuristic.
+// Unidirectional path tracing with NEE and BSDF sampling combined by the power heuristic, written
+// as a per-segment state machine: a kernel steps every lane once per iteration and restarts lanes
+// whose path ended, so SIMD lanes (lavapipe runs 8 in lockstep) stay busy however long paths are.
 // max_depth counts path segments: 1 shows emitters seen directly, 2 adds direct lighting.
 #ifndef PATH_TRACER_GLSL
 #define PATH_TRACER_GLSL
@@ -17,63 +19,81 @@ const uint RR_START_DEPTH = 3u;
 
 float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
-vec3 trace_path(uvec2 pixel, uint seed) {
+struct PathState {
+    vec3 origin;
+    vec3 dir;
+    vec3 beta;        // throughput of the prefix
+    vec3 radiance;    // radiance gathered so far
+    float prev_pdf;   // solid-angle pdf of the last BSDF sample (for MIS at emitter hits)
+    bool prev_delta;  // the last scattering was a delta lobe (or the camera): no MIS
+    uint depth;       // segments traced so far
+    uint seed;
+};
+
+PathState path_begin(uvec2 pixel, uint seed) {
+    PathState s;
     vec4 uc = rng_uniform4(seed, 0u, STREAM_CAMERA);
-    vec3 o = cam_position.xyz;
-    vec3 d = camera_ray_dir(float(pixel.x) + uc.x, float(pixel.y) + uc.y);
-    vec3 radiance = vec3(0.0);
-    vec3 beta = vec3(1.0);
-    float prev_pdf = 0.0;
-    bool prev_delta = true;
-    for (uint depth = 1u;; ++depth) {
-        Hit hit = trace_closest(o, d, RAY_TMAX);
-        if (hit.triangle == NO_HIT) {
-            if (max_component(scene_env.rgb) > 0.0) {
-                float w = prev_delta ? 1.0 : power_heuristic(prev_pdf, environment_pdf());
-                radiance += beta * scene_env.rgb * w;
-            }
-            break;
-        }
-        Triangle tri = triangles[hit.triangle];
-        Material m = materials[tri.material];
-        vec3 ng = normalize(cross(tri.e1, tri.e2));
-        vec3 x = tri.v0 + hit.bary.x * tri.e1 + hit.bary.y * tri.e2;
-        vec3 wo = -d;
-        if (tri.emitter != NO_EMITTER) {
-            vec3 le = emitted_radiance(tri, wo);
-            float w = prev_delta ? 1.0 : power_heuristic(prev_pdf, emitter_pdf(hit.triangle, d, hit.t));
-            radiance += beta * le * w;
-        }
-        if (depth >= max_depth) break;
+    s.origin = cam_position.xyz;
+    s.dir = camera_ray_dir(float(pixel.x) + uc.x, float(pixel.y) + uc.y);
+    s.beta = vec3(1.0);
+    s.radiance = vec3(0.0);
+    s.prev_pdf = 0.0;
+    s.prev_delta = true;
+    s.depth = 0u;
+    s.seed = seed;
+    return s;
+}
 
-        vec4 ul = rng_uniform4(seed, depth, STREAM_LIGHT);
-        LightSample ls = sample_light(x, ul.xyz);
-        if (ls.pdf > 0.0 && max_component(ls.radiance) > 0.0) {
-            vec3 f = bsdf_eval(m, ng, wo, ls.dir);
-            if (max_component(f) > 0.0) {
-                vec3 origin = offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng);
-                float tmax = isinf(ls.dist) ? RAY_TMAX : ls.dist * (1.0 - SHADOW_EPSILON);
-                if (!trace_occluded(origin, ls.dir, tmax)) {
-                    float w = power_heuristic(ls.pdf, bsdf_pdf(m, ng, wo, ls.dir));
-                    radiance += beta * f * ls.radiance * (w / ls.pdf);
-                }
-            }
+// Traces one segment and scatters at its end; returns false once the path has ended.
+bool path_step(inout PathState s) {
+    s.depth += 1u;
+    Hit hit = trace_closest(s.origin, s.dir, RAY_TMAX);
+    if (hit.triangle == NO_HIT) {
+        if (SCENE_ENVIRONMENT != 0 && max_component(scene_env.rgb) > 0.0) {
+            float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, environment_pdf());
+            s.radiance += s.beta * scene_env.rgb * w;
         }
-
-        BsdfSample bs = bsdf_sample(m, ng, wo, rng_uniform4(seed, depth, STREAM_BSDF));
-        if (bs.lobe == LOBE_NONE) break;
-        beta *= bs.weight;
-        prev_pdf = bs.pdf;
-        prev_delta = (bs.lobe & LOBE_DELTA) != 0u;
-        if ((flags & FLAG_RUSSIAN_ROULETTE) != 0u && depth >= RR_START_DEPTH) {
-            float survive = min(max_component(beta), RR_MAX_SURVIVAL);
-            if (ul.w >= survive) break;
-            beta /= survive;
-        }
-        o = offset_ray_origin(x, dot(bs.wi, ng) > 0.0 ? ng : -ng);
-        d = bs.wi;
+        return false;
     }
-    return radiance;
+    Triangle tri = triangles[hit.triangle];
+    Material m = materials[tri.material];
+    vec3 ng = normalize(cross(tri.e1, tri.e2));
+    vec3 x = tri.v0 + hit.bary.x * tri.e1 + hit.bary.y * tri.e2;
+    vec3 wo = -s.dir;
+    if (SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER) {
+        vec3 le = emitted_radiance(tri, wo);
+        float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, emitter_pdf(hit.triangle, s.dir, hit.t));
+        s.radiance += s.beta * le * w;
+    }
+    if (s.depth >= max_depth) return false;
+
+    vec4 ul = rng_uniform4(s.seed, s.depth, STREAM_LIGHT);
+    LightSample ls = sample_light(x, ul.xyz);
+    if (ls.pdf > 0.0 && max_component(ls.radiance) > 0.0) {
+        float bsdf_pdf;
+        vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
+        if (max_component(f) > 0.0) {
+            vec3 origin = offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng);
+            float tmax = isinf(ls.dist) ? RAY_TMAX : ls.dist * (1.0 - SHADOW_EPSILON);
+            if (!trace_occluded(origin, ls.dir, tmax)) {
+                s.radiance += s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
+            }
+        }
+    }
+
+    BsdfSample bs = bsdf_sample(m, ng, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
+    if (bs.lobe == LOBE_NONE) return false;
+    s.beta *= bs.weight;
+    s.prev_pdf = bs.pdf;
+    s.prev_delta = (bs.lobe & LOBE_DELTA) != 0u;
+    if ((flags & FLAG_RUSSIAN_ROULETTE) != 0u && s.depth >= RR_START_DEPTH) {
+        float survive = min(max_component(s.beta), RR_MAX_SURVIVAL);
+        if (ul.w >= survive) return false;
+        s.beta /= survive;
+    }
+    s.origin = offset_ray_origin(x, dot(bs.wi, ng) > 0.0 ? ng : -ng);
+    s.dir = bs.wi;
+    return true;
 }
 
 #endif

@@ -1,5 +1,6 @@
 #version 460
-// Progressive path tracing: each invocation adds samples_per_dispatch paths to its pixel's sums.
+// Progressive path tracing: each invocation adds samples_per_dispatch paths to its pixel's sums,
+// starting the next path as soon as one ends (see path_tracer.glsl).
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -16,10 +17,15 @@ void main() {
     uint pixel = p.y * width + p.x;
     vec3 sum = vec3(0.0);
     vec3 sum_sq = vec3(0.0);
-    for (uint s = 0u; s < samples_per_dispatch; ++s) {
-        vec3 l = trace_path(p, path_seed(pixel, sample_offset + s, render_seed));
-        sum += l;
-        sum_sq += l * l;
+    uint sample_index = 0u;
+    PathState path = path_begin(p, path_seed(pixel, sample_offset, render_seed));
+    while (true) {
+        if (path_step(path)) continue;
+        sum += path.radiance;
+        sum_sq += path.radiance * path.radiance;
+        sample_index += 1u;
+        if (sample_index == samples_per_dispatch) break;
+        path = path_begin(p, path_seed(pixel, sample_offset + sample_index, render_seed));
     }
     accum[pixel] += vec4(sum, float(samples_per_dispatch));
     accum_sq[pixel].rgb += sum_sq;

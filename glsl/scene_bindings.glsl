@@ -1,4 +1,4 @@
-// Set 0, bindings 0-4: the frame parameters and the scene. Kernels add their own from binding 5.
+// Set 0, bindings 0-4: the frame parameters and the scene (storage or uniform buffers, see below). Kernels add their own from binding 5.
 // Twin of FrameParams: src/gpu_types.rs.
 #ifndef SCENE_BINDINGS_GLSL
 #define SCENE_BINDINGS_GLSL
@@ -22,9 +22,21 @@ layout(std140, set = 0, binding = 0) uniform FrameParams {
 };
 const uint FLAG_RUSSIAN_ROULETTE = 1u;
 
+// On CPU devices small scenes are bound as uniform buffers, whose loads llvmpipe handles much
+// faster than storage-buffer loads; the array sizes are then compile-time constants.
+#ifndef SCENE_UNIFORM_BUFFERS
+#define SCENE_UNIFORM_BUFFERS 0
+#endif
+#if SCENE_UNIFORM_BUFFERS
+layout(std140, set = 0, binding = 1) uniform Triangles { Triangle triangles[SCENE_TRIANGLE_COUNT]; };
+layout(std140, set = 0, binding = 2) uniform Nodes { BvhNode nodes[SCENE_NODE_COUNT]; };
+layout(std140, set = 0, binding = 3) uniform Materials { Material materials[SCENE_MATERIAL_COUNT]; };
+layout(std140, set = 0, binding = 4) uniform Emitters { Emitter emitters[SCENE_EMITTER_SLOTS]; };
+#else
 layout(std430, set = 0, binding = 1) readonly buffer Triangles { Triangle triangles[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Nodes { BvhNode nodes[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Materials { Material materials[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Emitters { Emitter emitters[]; };
+#endif
 
 #endif

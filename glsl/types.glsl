@@ -25,14 +25,18 @@ struct Triangle {
 };
 const uint NO_EMITTER = 0xffffffffu;
 
-// Interior nodes have count 0: left child is the next node, right child is `index`.
-// Leaves cover triangles [index, index + count).
+// Depth-first nodes with skip links (stackless traversal): on a box hit an interior node
+// continues at the next node (its left child), a leaf tests its triangles and continues at `skip`;
+// on a miss traversal continues at `skip`. skip == node count ends the traversal.
+// Leaves pack (first triangle << LEAF_COUNT_BITS) | count into `leaf`; interior nodes have leaf 0.
 struct BvhNode {
     vec3 lo;
-    uint index;
+    uint skip;
     vec3 hi;
-    uint count;
+    uint leaf;
 };
+const uint LEAF_COUNT_BITS = 4u;
+const uint LEAF_COUNT_MASK = 15u;
 
 // One emissive triangle with its alias-table entry (selection proportional to power).
 struct Emitter {

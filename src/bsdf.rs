@@ -175,21 +175,10 @@ pub fn bsdf_eval_pdf_local(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     (f_cos, pdf)
 }
 
-fn local_frame(n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+/// (f * |cos_i| of the non-delta lobes, solid-angle pdf of `bsdf_sample` producing wi).
+pub fn bsdf_eval_pdf(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     let (t, b) = build_onb(n);
-    (to_local(wo, t, b, n), to_local(wi, t, b, n))
-}
-
-/// f * |cos_i| of the non-delta lobes.
-pub fn bsdf_eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
-    let (wo, wi) = local_frame(n, wo, wi);
-    bsdf_eval_pdf_local(m, wo, wi).0
-}
-
-/// Solid-angle pdf of `bsdf_sample` producing wi (non-delta lobes only).
-pub fn bsdf_pdf(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
-    let (wo, wi) = local_frame(n, wo, wi);
-    bsdf_eval_pdf_local(m, wo, wi).1
+    bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n))
 }
 
 /// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.

@@ -1,16 +1,18 @@
-//! Binned-SAH BVH built on the CPU and flattened depth-first, plus the traversal twin of
-//! glsl/bvh.glsl used as the oracle for GPU hits.
+//! Binned-SAH BVH built on the CPU and flattened depth-first with skip links, plus the stackless
+//! traversal twin of glsl/bvh.glsl used as the oracle for GPU hits.
 
 use glam::{Vec2, Vec3};
 
-use crate::gpu_types::{BvhNode, Triangle};
+use crate::gpu_types::{BvhNode, Triangle, LEAF_COUNT_BITS, LEAF_COUNT_MASK};
 
 pub const NO_HIT: u32 = u32::MAX;
 const SAH_BINS: usize = 16;
 const MAX_LEAF_TRIANGLES: usize = 4;
-/// Past this depth splits fall back to the object median, which bounds the traversal stack.
+/// A leaf may hold up to this many triangles when SAH finds no cheaper split.
+const MAX_SAH_LEAF_TRIANGLES: usize = 12;
+/// Past this depth splits fall back to the object median, which bounds the recursion.
 const SAH_MAX_DEPTH: usize = 40;
-pub const BVH_STACK_SIZE: usize = 64;
+const _: () = assert!(MAX_SAH_LEAF_TRIANGLES as u32 <= LEAF_COUNT_MASK);
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
@@ -93,34 +95,36 @@ impl Builder<'_> {
         (b, c)
     }
 
-    fn build(&mut self, start: usize, end: usize, depth: usize) -> usize {
+    fn build(&mut self, start: usize, end: usize, depth: usize) {
         let (bounds, centroid_bounds) = self.range_bounds(start, end);
         let node_index = self.nodes.len();
+        let count = end - start;
+        let leaf = (start as u32) << LEAF_COUNT_BITS | count as u32;
         self.nodes.push(BvhNode {
             lo: bounds.lo.into(),
             hi: bounds.hi.into(),
-            index: start as u32,
-            count: (end - start) as u32,
+            skip: 0,
+            leaf,
         });
-        let count = end - start;
-        if count <= MAX_LEAF_TRIANGLES {
-            return node_index;
+        if count > MAX_LEAF_TRIANGLES {
+            let split = if depth < SAH_MAX_DEPTH {
+                self.sah_split(start, end, &bounds, &centroid_bounds)
+            } else {
+                None
+            };
+            let mid = match split {
+                Some(mid) => Some(mid),
+                None if count > MAX_SAH_LEAF_TRIANGLES || depth >= SAH_MAX_DEPTH => Some(self.median_split(start, end, &centroid_bounds)),
+                None => None,
+            };
+            if let Some(mid) = mid {
+                self.build(start, mid, depth + 1);
+                self.build(mid, end, depth + 1);
+                self.nodes[node_index].leaf = 0;
+            }
         }
-        let split = if depth < SAH_MAX_DEPTH {
-            self.sah_split(start, end, &bounds, &centroid_bounds)
-        } else {
-            None
-        };
-        let mid = match split {
-            Some(mid) => mid,
-            None if count > MAX_LEAF_TRIANGLES * 4 || depth >= SAH_MAX_DEPTH => self.median_split(start, end, &centroid_bounds),
-            None => return node_index,
-        };
-        self.build(start, mid, depth + 1);
-        let right = self.build(mid, end, depth + 1);
-        self.nodes[node_index].index = right as u32;
-        self.nodes[node_index].count = 0;
-        node_index
+        // The subtree is complete: whatever comes next is where a miss (or a finished leaf) goes.
+        self.nodes[node_index].skip = self.nodes.len() as u32;
     }
 
     /// Partitions by the cheapest of SAH_BINS bins per axis; `None` if a leaf is cheaper.
@@ -162,7 +166,7 @@ impl Builder<'_> {
         let (cost, axis, k) = best?;
         // Traversal costs about one triangle test per node visit.
         let leaf_cost = bounds.half_area() * (end - start) as f32;
-        if cost + bounds.half_area() >= leaf_cost && end - start <= MAX_LEAF_TRIANGLES * 4 {
+        if cost + bounds.half_area() >= leaf_cost && end - start <= MAX_SAH_LEAF_TRIANGLES {
             return None;
         }
         let scale = SAH_BINS as f32 / extent[axis];
@@ -213,17 +217,13 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, tri: &Triangle, tmax: f32) -> Option
     (t > 0.0 && t < tmax).then_some((t, Vec2::new(b1, b2)))
 }
 
-pub fn intersect_aabb(o: Vec3, inv_d: Vec3, lo: Vec3, hi: Vec3, tmax: f32) -> f32 {
-    let t0 = (lo - o) * inv_d;
-    let t1 = (hi - o) * inv_d;
+pub fn intersect_aabb(o_inv_d: Vec3, inv_d: Vec3, lo: Vec3, hi: Vec3, tmax: f32) -> bool {
+    let t0 = lo * inv_d - o_inv_d;
+    let t1 = hi * inv_d - o_inv_d;
     let (tn, tf) = (t0.min(t1), t0.max(t1));
     let enter = tn.x.max(tn.y).max(tn.z.max(0.0));
     let leave = tf.x.min(tf.y).min(tf.z.min(tmax));
-    if enter <= leave {
-        enter
-    } else {
-        f32::INFINITY
-    }
+    enter <= leave
 }
 
 pub fn safe_inverse(d: Vec3) -> Vec3 {
@@ -239,49 +239,28 @@ pub fn bvh_traverse(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3,
         bary: Vec2::ZERO,
     };
     let inv_d = safe_inverse(d);
-    let bounds = |i: usize| (Vec3::from(nodes[i].lo), Vec3::from(nodes[i].hi));
-    let (lo, hi) = bounds(0);
-    if intersect_aabb(o, inv_d, lo, hi, hit.t) == f32::INFINITY {
-        return hit;
-    }
-    let mut stack = [0usize; BVH_STACK_SIZE];
-    let mut sp = 0;
+    let o_inv_d = o * inv_d;
     let mut node = 0usize;
-    loop {
-        let n = nodes[node];
-        if n.count > 0 {
-            for i in n.index..n.index + n.count {
-                if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t) {
-                    hit = Hit { t, triangle: i, bary };
-                    if any_hit {
-                        return hit;
-                    }
+    while node < nodes.len() {
+        let n = &nodes[node];
+        if !intersect_aabb(o_inv_d, inv_d, Vec3::from(n.lo), Vec3::from(n.hi), hit.t) {
+            node = n.skip as usize;
+            continue;
+        }
+        let (first, count) = n.leaf_range();
+        if count == 0 {
+            node += 1;
+            continue;
+        }
+        for i in first..first + count {
+            if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t) {
+                hit = Hit { t, triangle: i, bary };
+                if any_hit {
+                    return hit;
                 }
             }
-        } else {
-            let (left, right) = (node + 1, n.index as usize);
-            let (llo, lhi) = bounds(left);
-            let (rlo, rhi) = bounds(right);
-            let tl = intersect_aabb(o, inv_d, llo, lhi, hit.t);
-            let tr = intersect_aabb(o, inv_d, rlo, rhi, hit.t);
-            let (hit_l, hit_r) = (tl != f32::INFINITY, tr != f32::INFINITY);
-            if hit_l && hit_r {
-                let (near, far) = if tl <= tr { (left, right) } else { (right, left) };
-                stack[sp] = far;
-                sp += 1;
-                node = near;
-                continue;
-            }
-            if hit_l || hit_r {
-                node = if hit_l { left } else { right };
-                continue;
-            }
         }
-        if sp == 0 {
-            break;
-        }
-        sp -= 1;
-        node = stack[sp];
+        node = n.skip as usize;
     }
     hit
 }

@@ -33,9 +33,19 @@ pub struct Triangle {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhNode {
     pub lo: [f32; 3],
-    pub index: u32,
+    pub skip: u32,
     pub hi: [f32; 3],
-    pub count: u32,
+    pub leaf: u32,
+}
+
+pub const LEAF_COUNT_BITS: u32 = 4;
+pub const LEAF_COUNT_MASK: u32 = 15;
+
+impl BvhNode {
+    /// (first triangle, count) of a leaf; count 0 for interior nodes.
+    pub fn leaf_range(&self) -> (u32, u32) {
+        (self.leaf >> LEAF_COUNT_BITS, self.leaf & LEAF_COUNT_MASK)
+    }
 }
 
 #[repr(C)]

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use restir_pt::cli::{self, DeviceArgs, RenderArgs};
 
 #[derive(Parser)]
@@ -25,6 +25,18 @@ enum Command {
     Info { scene: PathBuf },
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
     Bench(BenchCmd),
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Toggle {
+    On,
+    Off,
+}
+
+impl Toggle {
+    fn on(self) -> bool {
+        self == Toggle::On
+    }
 }
 
 #[derive(Args)]
@@ -53,9 +65,9 @@ struct RenderCmd {
     max_depth: u32,
     #[arg(long, default_value_t = 0)]
     seed: u32,
-    /// Glossy/diffuse Russian roulette from the third segment on (off by default).
-    #[arg(long)]
-    russian_roulette: bool,
+    /// Russian roulette from the third segment on (survival = max throughput, at most 0.95).
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    russian_roulette: Toggle,
     /// Index of the glTF camera to render from (scene order).
     #[arg(long, default_value_t = 0)]
     camera: usize,
@@ -86,6 +98,9 @@ struct BenchCmd {
     spp: u32,
     #[arg(long, default_value_t = 8)]
     max_depth: u32,
+    /// Russian roulette from the third segment on, as in `render`.
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    russian_roulette: Toggle,
     /// Timed runs after one warm-up run.
     #[arg(long, default_value_t = 5)]
     runs: u32,
@@ -120,7 +135,7 @@ fn main() -> ExitCode {
             height: r.height,
             max_depth: r.max_depth,
             seed: r.seed,
-            russian_roulette: r.russian_roulette,
+            russian_roulette: r.russian_roulette.on(),
             camera: r.camera,
             out: r.out,
             png: r.png,
@@ -136,6 +151,7 @@ fn main() -> ExitCode {
             spp: b.spp,
             max_depth: b.max_depth,
             runs: b.runs,
+            russian_roulette: b.russian_roulette.on(),
             report: b.report,
             device: b.device.into(),
         }),

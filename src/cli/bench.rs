@@ -16,6 +16,7 @@ pub struct BenchArgs {
     pub spp: u32,
     pub max_depth: u32,
     pub runs: u32,
+    pub russian_roulette: bool,
     pub report: Option<PathBuf>,
     pub device: DeviceArgs,
 }
@@ -28,6 +29,7 @@ struct BenchReport {
     height: u32,
     spp: u32,
     max_depth: u32,
+    russian_roulette: bool,
     runs: u32,
     median_paths_per_second: f64,
     min_paths_per_second: f64,
@@ -53,6 +55,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         height: args.height,
         spp: args.spp,
         max_depth: args.max_depth,
+        russian_roulette: args.russian_roulette,
         ..Default::default()
     };
     settings.validate(&scene)?;
@@ -87,6 +90,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         height: settings.height,
         spp: settings.spp,
         max_depth: settings.max_depth,
+        russian_roulette: settings.russian_roulette,
         runs,
         median_paths_per_second: median(rates.clone()),
         min_paths_per_second: rates.iter().copied().fold(f64::INFINITY, f64::min),

@@ -10,8 +10,12 @@ use super::{Image, RenderSettings, SceneGpu};
 use crate::scene::Scene;
 use crate::vk::{Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
 
-/// Submissions are sized to about this much GPU time, which keeps any watchdog far away.
-const TARGET_SUBMISSION_MS: f64 = 250.0;
+/// Submissions are sized to about this much GPU time, which keeps GPU watchdogs far away.
+const TARGET_SUBMISSION_MS_GPU: f64 = 250.0;
+/// A CPU device (lavapipe) has no watchdog; longer submissions let paths regenerate within a lane.
+const TARGET_SUBMISSION_MS_CPU: f64 = 1500.0;
+/// How fast the adaptive chunk may grow from one submission to the next.
+const MAX_CHUNK_GROWTH: u32 = 8;
 const LOCAL_SIZE: u32 = 8;
 
 pub struct RenderStats {
@@ -57,17 +61,10 @@ impl PathTracer {
         )?;
         let accum = Buffer::new(ctx, "accumulation", pixels * 16, BufferUsage::Storage)?;
         let accum_sq = Buffer::new(ctx, "accumulation of squares", pixels * 16, BufferUsage::Storage)?;
-        let bindings = [
-            Binding::Uniform,
-            Binding::Storage,
-            Binding::Storage,
-            Binding::Storage,
-            Binding::Storage,
-            Binding::Storage,
-            Binding::Storage,
-        ];
-        let kernel = Kernel::new(ctx, "pathtrace.comp", &[], &bindings, 0)?;
-        let mut buffers = scene_gpu.bindings(&params);
+        let mut bindings = scene_gpu.bindings();
+        bindings.extend([Binding::Storage, Binding::Storage]);
+        let kernel = Kernel::new(ctx, "pathtrace.comp", &scene_gpu.defines(), &bindings, 0)?;
+        let mut buffers = scene_gpu.buffers(&params);
         buffers.extend([&accum, &accum_sq]);
         kernel.bind(&buffers);
         accum.fill(0)?;
@@ -118,6 +115,11 @@ impl PathTracer {
         let mut submissions = 0;
         let mut chunk = 1u32;
         let mut interrupted = false;
+        let target_ms = if self.ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU {
+            TARGET_SUBMISSION_MS_CPU
+        } else {
+            TARGET_SUBMISSION_MS_GPU
+        };
         while self.samples_done < self.settings.spp {
             if cancel.load(Ordering::Relaxed) {
                 interrupted = true;
@@ -130,7 +132,7 @@ impl PathTracer {
             submissions += 1;
             progress(self.samples_done);
             let per_sample = ms / samples as f64;
-            chunk = ((TARGET_SUBMISSION_MS / per_sample.max(1e-3)) as u32).clamp(1, 2 * samples.max(1));
+            chunk = ((target_ms / per_sample.max(1e-3)) as u32).clamp(1, MAX_CHUNK_GROWTH * samples);
         }
         Ok(RenderStats {
             spp: self.samples_done,

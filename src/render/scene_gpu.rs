@@ -1,33 +1,86 @@
-//! The scene's storage buffers (bindings 1-4 of glsl/scene_bindings.glsl).
+//! The scene's buffers (bindings 1-4 of glsl/scene_bindings.glsl) and the `#define`s that
+//! specialise scene kernels to what the scene contains.
 
 use std::sync::Arc;
 
 use anyhow::{Context as _, Result};
+use ash::vk::PhysicalDeviceType;
 
+use crate::bsdf::lobe_weights;
+use crate::error::GpuError;
 use crate::scene::Scene;
-use crate::vk::{Buffer, Context};
+use crate::vk::{Binding, Buffer, Context};
 
 pub struct SceneGpu {
     pub triangles: Buffer,
     pub nodes: Buffer,
     pub materials: Buffer,
     pub emitters: Buffer,
+    /// Scene arrays are bound as uniform buffers (CPU devices, small scenes), else storage buffers.
+    pub uniform: bool,
+    defines: Vec<(&'static str, String)>,
 }
 
 impl SceneGpu {
     pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
         let source = scene.source.display();
-        let upload = |name: &str, r: Result<Buffer, crate::error::GpuError>| r.with_context(|| format!("{source}: uploading {name}"));
+        let upload = |name: &str, r: Result<Buffer, GpuError>| r.with_context(|| format!("{source}: uploading {name}"));
+        let arrays = [
+            std::mem::size_of_val(scene.triangles.as_slice()),
+            std::mem::size_of_val(scene.nodes.as_slice()),
+            std::mem::size_of_val(scene.materials.as_slice()),
+            std::mem::size_of_val(scene.emitters.as_slice()),
+        ];
+        // Divergent uniform-buffer indexing serialises on GPUs; on llvmpipe it beats storage loads.
+        let uniform = ctx.info.device_type == PhysicalDeviceType::CPU
+            && arrays.iter().all(|&bytes| bytes as u64 <= ctx.info.max_uniform_buffer_range);
         Ok(Self {
             triangles: upload("triangles", Buffer::from_slice(ctx, "triangles", &scene.triangles))?,
             nodes: upload("BVH nodes", Buffer::from_slice(ctx, "BVH nodes", &scene.nodes))?,
             materials: upload("materials", Buffer::from_slice(ctx, "materials", &scene.materials))?,
             emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &scene.emitters))?,
+            uniform,
+            defines: scene_defines(scene, uniform),
         })
     }
 
-    /// The scene bindings 1-4 in order, after the frame parameters at binding 0.
-    pub fn bindings<'a>(&'a self, params: &'a Buffer) -> Vec<&'a Buffer> {
+    /// The buffers for bindings 0-4, the frame parameters first.
+    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<&'a Buffer> {
         vec![params, &self.triangles, &self.nodes, &self.materials, &self.emitters]
     }
+
+    /// The descriptor kinds of bindings 0-4.
+    pub fn bindings(&self) -> Vec<Binding> {
+        let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
+        vec![Binding::Uniform, scene, scene, scene, scene]
+    }
+
+    /// The `#define`s every scene kernel is compiled with.
+    pub fn defines(&self) -> Vec<(&str, &str)> {
+        self.defines.iter().map(|(k, v)| (*k, v.as_str())).collect()
+    }
+}
+
+/// Specialises kernels to the BSDF lobes and light types the scene uses, and sizes the uniform
+/// arrays when the scene is bound as uniform buffers.
+fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
+    let used = |pick: fn((f32, f32, f32)) -> f32| scene.materials.iter().any(|m| pick(lobe_weights(m)) > 0.0);
+    let flag = |on: bool| if on { "1" } else { "0" }.to_string();
+    let mut defines = vec![
+        ("BSDF_DIFFUSE", flag(used(|w| w.0))),
+        ("BSDF_CONDUCTOR", flag(used(|w| w.1))),
+        ("BSDF_DIELECTRIC", flag(used(|w| w.2))),
+        ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
+        ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
+        ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
+    ];
+    if uniform {
+        defines.extend([
+            ("SCENE_TRIANGLE_COUNT", scene.triangles.len().to_string()),
+            ("SCENE_NODE_COUNT", scene.nodes.len().to_string()),
+            ("SCENE_MATERIAL_COUNT", scene.materials.len().to_string()),
+            ("SCENE_EMITTER_SLOTS", scene.emitters.len().max(1).to_string()),
+        ]);
+    }
+    defines
 }

@@ -11,7 +11,8 @@ use crate::error::{vk_error, GpuError};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BufferUsage {
-    /// Read or written by kernels; lives in device memory, reached by staging copies.
+    /// Read or written by kernels; lives in device memory, reached by staging copies. Also
+    /// bindable as a uniform buffer, which small read-only scene arrays use on CPU devices.
     Storage,
     /// Small inputs rewritten from the host between dispatches; host-visible.
     Uniform,
@@ -35,7 +36,10 @@ impl Buffer {
         }
         let (flags, location) = match usage {
             BufferUsage::Storage => (
-                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+                vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::UNIFORM_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             ),
             BufferUsage::Uniform => (vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu),
