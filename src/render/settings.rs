@@ -28,7 +28,7 @@ impl Default for RenderSettings {
             spp: 64,
             max_depth: 8,
             seed: 0,
-            russian_roulette: false,
+            russian_roulette: true,
             camera: 0,
         }
     }
