@@ -19,8 +19,9 @@
 #define BSDF_DIELECTRIC 1
 #endif
 
-// Below this alpha (roughness 0.01) a lobe is treated as a perfect (delta) specular.
-const float DELTA_ALPHA = 1e-4;
+// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes are
+// ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
+const float DELTA_ALPHA = 1e-3;
 
 const uint LOBE_NONE = 0u;
 const uint LOBE_DIFFUSE = 1u;
@@ -38,17 +39,18 @@ struct BsdfSample {
 
 float ggx_alpha(float roughness) { return roughness * roughness; }
 
+// sin^2 comes from x^2 + y^2 rather than 1 - z^2: near the lobe peak of a narrow GGX the latter
+// cancels catastrophically in f32.
 float ggx_d(vec3 h, float alpha) {
     float a2 = alpha * alpha;
-    float c2 = h.z * h.z;
-    float d = c2 * (a2 - 1.0) + 1.0;
+    float d = (h.x * h.x + h.y * h.y) + h.z * h.z * a2;
     return a2 / (PI * d * d);
 }
 
 float smith_lambda(vec3 w, float alpha) {
     float c2 = w.z * w.z;
     if (c2 <= 0.0) return 0.0;
-    float t2 = max(0.0, 1.0 - c2) / c2;
+    float t2 = (w.x * w.x + w.y * w.y) / c2;
     return 0.5 * (-1.0 + sqrt(1.0 + alpha * alpha * t2));
 }
 
@@ -202,7 +204,11 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
             return s;
         }
         vec3 h = sample_ggx_vndf(wo_s, alpha, u.xy);
-        wi = reflect(-wo_s, h) * vec3(1.0, 1.0, side);
+        vec3 wi_s = reflect(-wo_s, h);
+        // Below the surface the conductor has no density; another lobe's pdf there must not
+        // turn this sample into a success.
+        if (wi_s.z <= 0.0) return s;
+        wi = wi_s * vec3(1.0, 1.0, side);
     } else if (BSDF_DIELECTRIC != 0 && w_t > 0.0) {
         lobe = LOBE_DIELECTRIC;
         if (alpha < DELTA_ALPHA) {
@@ -226,11 +232,14 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
         // Visible normals are sampled from wo mirrored through the origin, as the pdf assumes.
         vec3 wm = sample_ggx_vndf(wo * side, alpha, u.xy);
         float fr = fresnel_dielectric(dot(wo, wm), m.ior);
+        // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
+        // evaluated for the other event.
         if (u.w < fr) {
             wi = reflect(-wo, wm);
+            if (wi.z * wo.z <= 0.0) return s;
         } else {
             float etap;
-            if (!refract_dir(wo, wm, m.ior, wi, etap)) return s;
+            if (!refract_dir(wo, wm, m.ior, wi, etap) || wi.z * wo.z >= 0.0) return s;
             lobe |= LOBE_TRANSMISSION;
         }
     } else {

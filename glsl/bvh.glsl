@@ -3,6 +3,7 @@
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
+#include "loop_budget.glsl"
 #include "types.glsl"
 
 const uint NO_HIT = 0xffffffffu;
@@ -61,6 +62,7 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     uint end = nodes.length();
     uint node = 0u;
     while (node < end) {
+        loop_tick();
         BvhNode n = nodes[node];
         if (!intersect_aabb(o_inv_d, inv_d, n.lo, n.hi, hit.t)) {
             node = n.skip;
@@ -72,7 +74,9 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
         }
         uint first = n.leaf >> LEAF_COUNT_BITS;
         uint last = first + (n.leaf & LEAF_COUNT_MASK);
-        for (uint i = first; i < last; ++i) {
+        uint i = first;
+        for (; i < last; ++i) {
+            loop_tick();
             float t;
             vec2 bary;
             if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)) {
@@ -82,8 +86,10 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
                 if (any_hit) return hit;
             }
         }
+        note_loop_exit(i < last);
         node = n.skip;
     }
+    note_loop_exit(node < end);
     return hit;
 }
 

@@ -10,16 +10,22 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, set = 0, binding = 5) buffer Accum { vec4 accum[]; };       // rgb: sum of L, w: count
 layout(std430, set = 0, binding = 6) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of L^2
+layout(std430, set = 0, binding = 7) buffer Status {
+    uint max_loop_iterations;
+    uint loop_budget_cut_groups;
+};
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
-    if (p.x >= width || p.y >= height) return;
+    // Lanes outside the image still reach the loop-budget report below, so no early return.
+    bool inside = p.x < width && p.y < height;
     uint pixel = p.y * width + p.x;
     vec3 sum = vec3(0.0);
     vec3 sum_sq = vec3(0.0);
     uint sample_index = 0u;
     PathState path = path_begin(p, path_seed(pixel, sample_offset, render_seed));
-    while (true) {
+    while (inside) {
+        loop_tick();
         if (path_step(path)) continue;
         sum += path.radiance;
         sum_sq += path.radiance * path.radiance;
@@ -27,6 +33,15 @@ void main() {
         if (sample_index == samples_per_dispatch) break;
         path = path_begin(p, path_seed(pixel, sample_offset + sample_index, render_seed));
     }
-    accum[pixel] += vec4(sum, float(samples_per_dispatch));
-    accum_sq[pixel].rgb += sum_sq;
+    note_loop_exit(inside && sample_index < samples_per_dispatch);
+    if (inside) {
+        accum[pixel] += vec4(sum, float(samples_per_dispatch));
+        accum_sq[pixel].rgb += sum_sq;
+    }
+    uint iterations = subgroup_loop_iterations();
+    bool cut = subgroup_loop_budget_cut();
+    if (subgroupElect()) {
+        atomicMax(max_loop_iterations, iterations);
+        if (cut) atomicAdd(loop_budget_cut_groups, 1u);
+    }
 }

@@ -7,7 +7,9 @@ use std::f32::consts::PI;
 use crate::gpu_types::Material;
 use crate::sampling::{build_onb, pdf_cosine_hemisphere, sample_cosine_hemisphere, sample_ggx_vndf, to_local, to_world, INV_PI};
 
-pub const DELTA_ALPHA: f32 = 1e-4;
+/// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes
+/// are ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
+pub const DELTA_ALPHA: f32 = 1e-3;
 
 pub const LOBE_NONE: u32 = 0;
 pub const LOBE_DIFFUSE: u32 = 1;
@@ -37,10 +39,11 @@ pub fn ggx_alpha(roughness: f32) -> f32 {
     roughness * roughness
 }
 
+/// sin^2 comes from x^2 + y^2 rather than 1 - z^2: near the lobe peak of a narrow GGX the
+/// latter cancels catastrophically in f32.
 pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
-    let c2 = h.z * h.z;
-    let d = c2 * (a2 - 1.0) + 1.0;
+    let d = (h.x * h.x + h.y * h.y) + h.z * h.z * a2;
     a2 / (PI * d * d)
 }
 
@@ -49,7 +52,7 @@ pub fn smith_lambda(w: Vec3, alpha: f32) -> f32 {
     if c2 <= 0.0 {
         return 0.0;
     }
-    let t2 = (1.0 - c2).max(0.0) / c2;
+    let t2 = (w.x * w.x + w.y * w.y) / c2;
     0.5 * (-1.0 + (1.0 + alpha * alpha * t2).sqrt())
 }
 
@@ -207,7 +210,13 @@ pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample
             };
         }
         let h = sample_ggx_vndf(wo_s, alpha, u.truncate().truncate());
-        (reflect(-wo_s, h) * flip, LOBE_CONDUCTOR)
+        let wi_s = reflect(-wo_s, h);
+        // Below the surface the conductor has no density; another lobe's pdf there must not
+        // turn this sample into a success.
+        if wi_s.z <= 0.0 {
+            return BsdfSample::FAILED;
+        }
+        (wi_s * flip, LOBE_CONDUCTOR)
     } else {
         if w_t <= 0.0 {
             return BsdfSample::FAILED;
@@ -234,13 +243,19 @@ pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample
         }
         let wm = sample_ggx_vndf(wo * side, alpha, u.truncate().truncate());
         let fr = fresnel_dielectric(wo.dot(wm), m.ior);
+        // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
+        // evaluated for the other event.
         if u.w < fr {
-            (reflect(-wo, wm), LOBE_DIELECTRIC)
-        } else {
-            let Some((wt, _)) = refract_dir(wo, wm, m.ior) else {
+            let wi = reflect(-wo, wm);
+            if wi.z * wo.z <= 0.0 {
                 return BsdfSample::FAILED;
-            };
-            (wt, LOBE_DIELECTRIC | LOBE_TRANSMISSION)
+            }
+            (wi, LOBE_DIELECTRIC)
+        } else {
+            match refract_dir(wo, wm, m.ior) {
+                Some((wt, _)) if wt.z * wo.z < 0.0 => (wt, LOBE_DIELECTRIC | LOBE_TRANSMISSION),
+                _ => return BsdfSample::FAILED,
+            }
         }
     };
     let (f_cos, pdf) = bsdf_eval_pdf_local(m, wo, wi);

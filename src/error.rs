@@ -13,6 +13,8 @@ pub enum GpuError {
     BindingTooLarge { what: String, needed: u64, limit: u64 },
     #[error("Vulkan call failed during {during}: {result:?}")]
     Vulkan { during: &'static str, result: vk::Result },
+    #[error("{groups} subgroup(s) of a dispatch ran out of the driver's loop budget ({limit} iterations per loop and shader invocation; about {counted} counted), which truncates paths: the render was stopped rather than written wrong")]
+    LoopLimit { limit: u32, counted: u32, groups: u32 },
     #[error("{count} Vulkan validation error(s) were reported; first: {first}")]
     Validation { count: u32, first: String },
 }

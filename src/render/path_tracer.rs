@@ -7,8 +7,9 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 
 use super::{Image, RenderSettings, SceneGpu};
+use crate::error::GpuError;
 use crate::scene::Scene;
-use crate::vk::{Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
+use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
 
 /// Submissions are sized to about this much GPU time, which keeps GPU watchdogs far away.
 const TARGET_SUBMISSION_MS_GPU: f64 = 250.0;
@@ -16,6 +17,11 @@ const TARGET_SUBMISSION_MS_GPU: f64 = 250.0;
 const TARGET_SUBMISSION_MS_CPU: f64 = 1500.0;
 /// How fast the adaptive chunk may grow from one submission to the next.
 const MAX_CHUNK_GROWTH: u32 = 8;
+/// Share of a driver's per-invocation loop budget a dispatch may plan to use; the rest absorbs
+/// pixels whose paths cost more than the ones measured so far.
+const LOOP_BUDGET_SHARE: f64 = 0.25;
+/// Words of glsl/pathtrace.comp's Status block: max loop iterations, subgroups with a cut loop.
+const STATUS_WORDS: u64 = 2;
 const LOCAL_SIZE: u32 = 8;
 
 pub struct RenderStats {
@@ -40,6 +46,7 @@ pub struct PathTracer {
     params: Buffer,
     accum: Buffer,
     accum_sq: Buffer,
+    status: Buffer,
     _scene_gpu: SceneGpu,
     timer: PassTimer,
     settings: RenderSettings,
@@ -61,11 +68,12 @@ impl PathTracer {
         )?;
         let accum = Buffer::new(ctx, "accumulation", pixels * 16, BufferUsage::Storage)?;
         let accum_sq = Buffer::new(ctx, "accumulation of squares", pixels * 16, BufferUsage::Storage)?;
+        let status = Buffer::new(ctx, "dispatch status", STATUS_WORDS * 4, BufferUsage::Storage)?;
         let mut bindings = scene_gpu.bindings();
-        bindings.extend([Binding::Storage, Binding::Storage]);
+        bindings.extend([Binding::Storage, Binding::Storage, Binding::Storage]);
         let kernel = Kernel::new(ctx, "pathtrace.comp", &scene_gpu.defines(), &bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
-        buffers.extend([&accum, &accum_sq]);
+        buffers.extend([&accum, &accum_sq, &status]);
         kernel.bind(&buffers);
         accum.fill(0)?;
         accum_sq.fill(0)?;
@@ -75,6 +83,7 @@ impl PathTracer {
             params,
             accum,
             accum_sq,
+            status,
             timer: PassTimer::new(ctx, 1)?,
             base_params: settings.frame_params(scene),
             settings: settings.clone(),
@@ -83,9 +92,9 @@ impl PathTracer {
         })
     }
 
-    /// Adds `samples` paths per pixel in one submission; returns its GPU time in ms (None if the
-    /// device has no timestamps).
-    pub fn dispatch(&mut self, samples: u32) -> Result<Option<f64>> {
+    /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the
+    /// device has no timestamps) and the most loop iterations any subgroup ran.
+    pub fn dispatch(&mut self, samples: u32) -> Result<(Option<f64>, u32)> {
         let mut params = self.base_params;
         params.sample_offset = self.samples_done;
         params.samples_per_dispatch = samples;
@@ -97,14 +106,38 @@ impl PathTracer {
         ];
         self.ctx
             .submit_and_wait(|cmd| {
+                self.status.record_fill(cmd, 0);
+                record_compute_barrier(&self.ctx.device, cmd);
                 self.timer.record_reset(cmd);
                 self.timer.record_begin(cmd, 0);
                 self.kernel.record_dispatch(cmd, groups, &[]);
                 self.timer.record_end(cmd, 0);
             })
             .context("path tracing")?;
+        let status = self.status.read::<u32>(STATUS_WORDS as usize)?;
+        let (iterations, cut_groups) = (status[0], status[1]);
+        if cut_groups > 0 {
+            let limit = self.ctx.info.loop_iteration_limit.unwrap_or(0);
+            return Err(GpuError::LoopLimit {
+                limit,
+                counted: iterations,
+                groups: cut_groups,
+            }
+            .into());
+        }
         self.samples_done += samples;
-        Ok(self.timer.read_ms(1)?.map(|t| t[0]))
+        Ok((self.timer.read_ms(1)?.map(|t| t[0]), iterations))
+    }
+
+    /// The largest chunk the driver's loop budget allows, from the last dispatch's cost.
+    fn loop_budget_chunk(&self, samples: u32, iterations: u32) -> u32 {
+        match self.ctx.info.loop_iteration_limit {
+            Some(limit) => {
+                let per_sample = iterations.max(1) as f64 / samples as f64;
+                ((LOOP_BUDGET_SHARE * limit as f64 / per_sample) as u32).max(1)
+            }
+            None => u32::MAX,
+        }
     }
 
     /// Renders the requested spp in adaptive chunks. `progress` receives the samples done;
@@ -127,12 +160,15 @@ impl PathTracer {
             }
             let samples = chunk.min(self.settings.spp - self.samples_done);
             let t0 = Instant::now();
-            let ms = self.dispatch(samples)?.unwrap_or_else(|| t0.elapsed().as_secs_f64() * 1e3);
+            let (ms, iterations) = self.dispatch(samples)?;
+            let ms = ms.unwrap_or_else(|| t0.elapsed().as_secs_f64() * 1e3);
             gpu_ms += ms;
             submissions += 1;
             progress(self.samples_done);
             let per_sample = ms / samples as f64;
-            chunk = ((target_ms / per_sample.max(1e-3)) as u32).clamp(1, MAX_CHUNK_GROWTH * samples);
+            chunk = ((target_ms / per_sample.max(1e-3)) as u32)
+                .clamp(1, MAX_CHUNK_GROWTH * samples)
+                .min(self.loop_budget_chunk(samples, iterations));
         }
         Ok(RenderStats {
             spp: self.samples_done,

@@ -12,6 +12,8 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use crate::error::{vk_error, GpuError};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+/// llvmpipe's LP_MAX_TGSI_LOOP_ITERATIONS: each loop's budget per shader invocation.
+const LLVMPIPE_LOOP_LIMIT: u32 = 65535;
 /// One submission must never block the caller forever; a healthy chunk finishes in well under this.
 const FENCE_TIMEOUT_NS: u64 = 120_000_000_000;
 
@@ -32,6 +34,9 @@ pub struct DeviceInfo {
     pub max_compute_workgroup_count: [u32; 3],
     pub timestamp_period_ns: f32,
     pub timestamps_supported: bool,
+    /// Iterations each loop of one shader invocation may run in total before the driver silently
+    /// leaves it (llvmpipe: 65535); `None` where no such cap is known.
+    pub loop_iteration_limit: Option<u32>,
 }
 
 /// Collects the validation layer's output so that tests can fail on it.
@@ -391,6 +396,7 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
         max_compute_workgroup_count: props.limits.max_compute_work_group_count,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamps_supported: timestamp_bits > 0 && props.limits.timestamp_compute_and_graphics == vk::TRUE,
+        loop_iteration_limit: device_name(&props).contains("llvmpipe").then_some(LLVMPIPE_LOOP_LIMIT),
     };
     Ok((chosen, family, info))
 }

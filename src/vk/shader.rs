@@ -12,10 +12,25 @@ pub fn glsl_source(name: &str) -> Option<&'static str> {
     GLSL_SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
+/// Joins `path` onto `dir` and folds "." and ".." segments, as the include table has no folders.
+fn normalize_path(dir: &str, path: &str) -> String {
+    let mut parts: Vec<&str> = Vec::new();
+    for segment in dir.split('/').chain(path.split('/')) {
+        match segment {
+            "" | "." => {}
+            ".." => {
+                parts.pop();
+            }
+            s => parts.push(s),
+        }
+    }
+    parts.join("/")
+}
+
 fn resolve_include(requested: &str, kind: shaderc::IncludeType, requester: &str) -> Option<(String, &'static str)> {
     let relative = match (kind, requester.rsplit_once('/')) {
-        (shaderc::IncludeType::Relative, Some((dir, _))) => format!("{dir}/{requested}"),
-        _ => requested.to_string(),
+        (shaderc::IncludeType::Relative, Some((dir, _))) => normalize_path(dir, requested),
+        _ => normalize_path("", requested),
     };
     // Includes written relative to a subfolder may still name a top-level file.
     [relative, requested.to_string()]

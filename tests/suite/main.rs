@@ -1,1 +1,14 @@
+//! The whole test suite in one binary (one link on 2 cores). GPU tests run on whatever Vulkan
+//! device is present (lavapipe in CI) with the validation layer on; any message fails the test.
 
+mod common;
+
+mod bsdf_oracle;
+mod bvh_oracle;
+mod cli;
+mod furnace;
+mod layout;
+mod rng_oracle;
+mod sampling_oracle;
+mod sampling_statistics;
+mod scene_loader;

@@ -1,0 +1,32 @@
+#version 460
+// Oracle kernel: BVH traversal, light sampling and camera rays against a real scene
+// (twins: src/bvh.rs, src/lights.rs, src/scene/camera.rs).
+#extension GL_GOOGLE_include_directive : require
+layout(local_size_x = 64) in;
+
+#include "../scene_bindings.glsl"
+#include "../bvh.glsl"
+#include "../camera.glsl"
+#include "../lights.glsl"
+
+// Per item: origin (w: tmax), direction, light-sample uniforms (xyz), image point (xy).
+layout(std430, set = 0, binding = 5) readonly buffer Inputs { vec4 inputs[]; };
+layout(std430, set = 0, binding = 6) writeonly buffer Outputs { vec4 outputs[]; };
+layout(push_constant) uniform Push { uint count; };
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= count) return;
+    vec4 o = inputs[4u * i];
+    vec3 d = inputs[4u * i + 1u].xyz;
+    vec3 u = inputs[4u * i + 2u].xyz;
+    vec2 px = inputs[4u * i + 3u].xy;
+    Hit h = trace_closest(o.xyz, d, o.w);
+    bool occluded = trace_occluded(o.xyz, d, o.w);
+    LightSample ls = sample_light(o.xyz, u);
+    outputs[5u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
+    outputs[5u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d));
+    outputs[5u * i + 2u] = vec4(ls.dir, ls.dist);
+    outputs[5u * i + 3u] = vec4(ls.radiance, ls.pdf);
+    outputs[5u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), 0.0);
+}

@@ -1,0 +1,199 @@
+//! GLSL bvh.glsl, lights.glsl and camera.glsl against their Rust twins on a non-trivial scene:
+//! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
+
+use glam::{Vec3, Vec4};
+use restir_pt::bvh::{offset_ray_origin, trace_closest, trace_occluded, NO_HIT};
+use restir_pt::gltf_writer::MeshData;
+use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
+use restir_pt::lights::sample_light;
+use restir_pt::render::{RenderSettings, SceneGpu};
+use restir_pt::scene::{Camera, Scene, SceneParts};
+use restir_pt::vk::{Buffer, BufferUsage};
+
+use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
+
+const RAYS: usize = 20_000;
+
+pub fn random_scene(seed: u64) -> Scene {
+    let mut r = TestRng(seed);
+    let mut triangles = Vec::new();
+    for i in 0..6000 {
+        let center = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
+        let size = 0.05 + 0.5 * r.uniform();
+        let v: Vec<Vec3> = (0..3).map(|_| center + size * r.unit_vector()).collect();
+        let material = if i % 50 == 0 { 1 } else { 0 };
+        triangles.push(Triangle {
+            v0: v[0].into(),
+            material,
+            e1: (v[1] - v[0]).into(),
+            emitter: NO_EMITTER,
+            e2: (v[2] - v[0]).into(),
+            pad: 0,
+        });
+    }
+    let sphere = MeshData::sphere(Vec3::new(1.0, 0.5, -0.5), 2.0, 16, 32);
+    for t in sphere.indices.chunks(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| sphere.positions[t[k] as usize]);
+        triangles.push(Triangle {
+            v0: a.into(),
+            material: 0,
+            e1: (b - a).into(),
+            emitter: NO_EMITTER,
+            e2: (c - a).into(),
+            pad: 0,
+        });
+    }
+    let materials = vec![
+        Material {
+            base_color: [0.5; 3],
+            roughness: 1.0,
+            ior: 1.5,
+            ..Default::default()
+        },
+        Material {
+            emission: [4.0, 3.0, 2.0],
+            roughness: 1.0,
+            ior: 1.5,
+            ..Default::default()
+        },
+    ];
+    Scene::build(SceneParts {
+        source: "random test scene".into(),
+        triangles,
+        materials,
+        material_names: vec!["grey".into(), "light".into()],
+        environment: Vec3::new(0.2, 0.3, 0.4),
+        cameras: vec![Camera::look_at("test", Vec3::new(0.0, 1.0, 12.0), Vec3::ZERO, Vec3::Y, 0.8)],
+        warnings: vec![],
+    })
+}
+
+#[test]
+fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
+    let ctx = gpu();
+    let scene = random_scene(1);
+    let settings = RenderSettings {
+        width: 64,
+        height: 48,
+        ..Default::default()
+    };
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(!scene_gpu.uniform, "this scene is meant to exercise the storage-buffer path");
+    let params = Buffer::new(
+        &ctx,
+        "params",
+        std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
+        BufferUsage::Uniform,
+    )
+    .unwrap();
+    params.write(&[settings.frame_params(&scene)]).unwrap();
+
+    let mut r = TestRng(2);
+    let mut inputs = Vec::with_capacity(4 * RAYS);
+    for i in 0..RAYS {
+        let o = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
+        // Half the rays are shadow-ray-like segments with a finite tmax.
+        let tmax = if i % 2 == 0 { 1e30 } else { 0.5 + 6.0 * r.uniform() };
+        inputs.push(o.extend(tmax));
+        inputs.push(r.unit_vector().extend(0.0));
+        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
+        inputs.push(Vec4::new(r.uniform() * 64.0, r.uniform() * 48.0, 0.0, 0.0));
+    }
+    let out: Vec<Vec4> = run_oracle(
+        &ctx,
+        "oracle/scene_oracle.comp",
+        &scene_gpu.buffers(&params),
+        &[bytemuck::cast_slice(&inputs)],
+        RAYS * 20,
+        RAYS as u32,
+    );
+
+    let camera = &scene.cameras[0];
+    let mut hits = 0;
+    for i in 0..RAYS {
+        let (o, d, u, px) = (
+            inputs[4 * i],
+            inputs[4 * i + 1].truncate(),
+            inputs[4 * i + 2].truncate(),
+            inputs[4 * i + 3],
+        );
+        let h = trace_closest(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
+        let g = &out[5 * i..5 * i + 5];
+        assert_eq!(
+            g[0].y.to_bits(),
+            h.triangle,
+            "trace_closest triangle, ray {i}: GLSL t {} vs Rust t {}",
+            g[0].x,
+            h.t
+        );
+        if h.triangle != NO_HIT {
+            hits += 1;
+            assert!(close(g[0].x, h.t, 1e-4), "trace_closest t, ray {i}");
+            assert!(
+                close(g[0].z, h.bary.x, 1e-4) && close(g[0].w, h.bary.y, 1e-4),
+                "trace_closest barycentrics, ray {i}"
+            );
+        }
+        let occluded = trace_occluded(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
+        assert_eq!(g[1].x == 1.0, occluded, "trace_occluded, ray {i}");
+        let off = offset_ray_origin(o.truncate(), d);
+        for k in 0..3 {
+            assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
+        }
+        let ls = sample_light(&scene, o.truncate(), u);
+        let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
+        assert!(
+            dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
+            "sample_light direction, item {i}"
+        );
+        assert!(
+            (g[3].truncate() - ls.radiance).abs().max_element() < 1e-4 && close(g[3].w, ls.pdf, 1e-3),
+            "sample_light value, item {i}"
+        );
+        let dir = camera.ray_dir(px.x, px.y, settings.width, settings.height);
+        assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
+    }
+    assert!(
+        hits > RAYS / 4,
+        "only {hits} of {RAYS} rays hit: the scene does not exercise traversal"
+    );
+    assert_clean(&ctx);
+}
+
+#[test]
+fn bvh_closest_hit_equals_brute_force() {
+    let scene = random_scene(4);
+    let mut r = TestRng(8);
+    for i in 0..5000 {
+        let o = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 14.0 - 7.0;
+        let d = r.unit_vector();
+        let h = trace_closest(&scene.nodes, &scene.triangles, o, d, 1e30);
+        let mut best = (1e30f32, NO_HIT);
+        for (k, tri) in scene.triangles.iter().enumerate() {
+            if let Some((t, _)) = restir_pt::bvh::intersect_triangle(o, d, tri, best.0) {
+                best = (t, k as u32);
+            }
+        }
+        assert_eq!(h.triangle, best.1, "ray {i}: BVH t {} vs brute force t {}", h.t, best.0);
+    }
+}
+
+#[test]
+fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
+    let scene = random_scene(9);
+    let mut seen = vec![0u32; scene.triangles.len()];
+    for node in &scene.nodes {
+        let (first, count) = node.leaf_range();
+        for t in first..first + count {
+            seen[t as usize] += 1;
+            for v in scene.triangles[t as usize].vertices() {
+                assert!(
+                    v.cmpge(Vec3::from(node.lo) - 1e-5).all() && v.cmple(Vec3::from(node.hi) + 1e-5).all(),
+                    "leaf does not bound its triangle"
+                );
+            }
+        }
+        assert!(node.skip as usize <= scene.nodes.len());
+    }
+    assert!(seen.iter().all(|&c| c == 1), "a triangle is in no leaf or in two");
+}

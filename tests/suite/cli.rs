@@ -1,0 +1,136 @@
+//! The restir-pt binary: a render with its summary and JSON report, and bad input that must
+//! exit non-zero with one clear line on stderr (never a panic).
+
+use std::process::Command;
+
+use crate::common::{repo_path, temp_file};
+
+fn restir_pt(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_restir-pt"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Exit code 1 and exactly one `error:` line that mentions every `needle`.
+fn assert_clean_failure(args: &[&str], needles: &[&str]) {
+    let (code, _, stderr) = restir_pt(args);
+    assert_eq!(code, 1, "{args:?} should fail; stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{args:?}: expected one error line, got: {stderr}");
+    for n in needles {
+        assert!(errors[0].contains(n), "{args:?}: error line {:?} does not mention {n:?}", errors[0]);
+    }
+}
+
+#[test]
+fn cli_render_writes_images_summary_and_report() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let (exr, png, report) = (dir.join("c.exr"), dir.join("c.png"), dir.join("r.json"));
+    let (code, stdout, stderr) = restir_pt(&[
+        "render",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--spp",
+        "4",
+        "--validate",
+        "--out",
+        exr.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("device: "), "the chosen device is printed: {stderr}");
+    assert!(
+        stdout.contains("32x24 | 4 spp") && stdout.contains("M paths/s"),
+        "summary line: {stdout}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for key in [
+        "device",
+        "width",
+        "height",
+        "spp",
+        "max_depth",
+        "gpu_ms",
+        "wall_ms",
+        "paths_per_second",
+    ] {
+        assert!(json.get(key).is_some(), "report lacks {key}: {json}");
+    }
+    assert_eq!(json["width"], 32);
+    let (w, h, pixels) = restir_pt::image_io::read_exr(&exr).unwrap();
+    assert_eq!((w, h), (32, 24));
+    assert!(pixels.iter().all(|p| p.is_finite()) && pixels.iter().any(|p| p.max_element() > 0.0));
+    assert!(std::fs::metadata(&png).unwrap().len() > 100);
+}
+
+#[test]
+fn cli_info_describes_the_default_scene() {
+    let (code, stdout, stderr) = restir_pt(&["info", repo_path("scenes/cornell.gltf").to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("triangles: 36") && stdout.contains("emitters: 2 triangles") && stdout.contains("cameras: 8"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn cli_bad_input_fails_with_one_clear_line() {
+    let missing = "no/such/scene.gltf";
+    assert_clean_failure(&["render", missing], &[missing, "cannot read"]);
+    let broken = temp_file("broken.gltf", b"{ \"asset\": { \"version\": ");
+    assert_clean_failure(&["render", broken.to_str().unwrap()], &["broken.gltf", "invalid glTF"]);
+    let truncated = temp_file("truncated.glb", b"glTF\x02\x00\x00\x00\xff\x00\x00\x00");
+    assert_clean_failure(&["info", truncated.to_str().unwrap()], &["truncated.glb"]);
+    assert_clean_failure(&["render", "--width", "0"], &["resolution 0x256"]);
+    assert_clean_failure(&["render", "--width", "100000", "--height", "100000"], &["too large"]);
+    assert_clean_failure(&["render", "--spp", "0"], &["--spp"]);
+    assert_clean_failure(&["render", "--max-depth", "0"], &["--max-depth"]);
+    assert_clean_failure(&["render", "--camera", "99"], &["--camera 99"]);
+    assert_clean_failure(
+        &["render", "--device", "no-such-gpu", "--width", "8", "--height", "8"],
+        &["no-such-gpu", "available"],
+    );
+}
+
+#[test]
+fn cli_max_depth_one_shows_only_emitters() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let exr = dir.join("d1.exr");
+    let (code, _, stderr) = restir_pt(&[
+        "render",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--spp",
+        "2",
+        "--max-depth",
+        "1",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let (_, _, pixels) = restir_pt::image_io::read_exr(&exr).unwrap();
+    let lit = pixels.iter().filter(|p| p.max_element() > 0.0).count();
+    assert!(
+        lit > 0 && lit < pixels.len() / 10,
+        "{lit} lit pixels: depth 1 must show only the ceiling light"
+    );
+    // Lit pixels see the light's radiance (17, 12, 4), scaled by the pixel's light coverage.
+    assert!(pixels
+        .iter()
+        .all(|p| p.max_element() == 0.0 || ((p.x / p.z - 17.0 / 4.0).abs() < 1e-3 && p.x <= 17.0 + 1e-3)));
+}

@@ -1,0 +1,105 @@
+//! Shared test helpers: a validated GPU context, oracle-kernel runs and tolerant comparisons.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use restir_pt::vk::{Binding, Buffer, Context, ContextOptions, Kernel};
+
+/// NaN bits pre-filled into every output buffer, so that an unwritten slot fails a comparison.
+pub const NAN_FILL: u32 = 0x7fc0_0000;
+
+pub fn gpu() -> Arc<Context> {
+    let ctx = Context::new(&ContextOptions {
+        device: None,
+        validation: true,
+    })
+    .expect("a Vulkan device with validation layers (tools/setup.sh)");
+    Arc::new(ctx)
+}
+
+/// Fails the test if the validation layer reported anything during it.
+pub fn assert_clean(ctx: &Context) {
+    if let Err(e) = ctx.check_validation() {
+        panic!("{e}");
+    }
+}
+
+pub fn repo_path(relative: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// Runs an oracle kernel over `count` items: `inputs` go to the first bindings, then one output
+/// buffer of `output_words` 32-bit words pre-filled with NaN, which is returned.
+pub fn run_oracle<T: bytemuck::Pod>(
+    ctx: &Arc<Context>,
+    kernel: &str,
+    leading: &[&Buffer],
+    inputs: &[&[u8]],
+    output_words: usize,
+    count: u32,
+) -> Vec<T> {
+    let input_buffers: Vec<Buffer> = inputs
+        .iter()
+        .enumerate()
+        .map(|(i, data)| Buffer::from_slice(ctx, &format!("oracle input {i}"), data).unwrap())
+        .collect();
+    let output = Buffer::new(ctx, "oracle output", output_words as u64 * 4, restir_pt::vk::BufferUsage::Storage).unwrap();
+    output.fill(NAN_FILL).unwrap();
+    let mut bindings: Vec<&Buffer> = leading.to_vec();
+    bindings.extend(input_buffers.iter());
+    bindings.push(&output);
+    let kinds: Vec<Binding> = bindings
+        .iter()
+        .enumerate()
+        .map(|(i, _)| {
+            if i == 0 && !leading.is_empty() {
+                Binding::Uniform
+            } else {
+                Binding::Storage
+            }
+        })
+        .collect();
+    let k = Kernel::new(ctx, kernel, &[], &kinds, 4).unwrap();
+    k.bind(&bindings);
+    k.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
+    let words = output.read::<u32>(output_words).unwrap();
+    bytemuck::cast_slice(&words).to_vec()
+}
+
+/// |a - b| <= tol * max(1, |a|, |b|): absolute near zero, relative for large values.
+pub fn close(a: f32, b: f32, tol: f32) -> bool {
+    if a.is_nan() || b.is_nan() {
+        return false;
+    }
+    (a - b).abs() <= tol * 1f32.max(a.abs()).max(b.abs())
+}
+
+/// A small deterministic generator for test inputs (SplitMix64).
+pub struct TestRng(pub u64);
+
+impl TestRng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    pub fn uniform(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    pub fn unit_vector(&mut self) -> glam::Vec3 {
+        restir_pt::sampling::sample_uniform_sphere(glam::Vec2::new(self.uniform(), self.uniform()))
+    }
+}
+
+/// Writes `contents` to a fresh file under the system temp folder and returns its path.
+pub fn temp_file(name: &str, contents: &[u8]) -> PathBuf {
+    static COUNTER: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("restir-pt-test-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, contents).unwrap();
+    path
+}

@@ -1,0 +1,115 @@
+//! Host structs against the GLSL layout: member offsets and array strides read from the SPIR-V
+//! that glslang produced (OpMemberDecorate Offset, OpDecorate ArrayStride) must equal the
+//! `#[repr(C)]` offsets and sizes of the Rust twins in src/gpu_types.rs.
+
+use std::collections::HashMap;
+
+use restir_pt::gpu_types::{BvhNode, Emitter, FrameParams, Material, Triangle};
+use restir_pt::vk::compile_kernel;
+
+const OP_NAME: u32 = 5;
+const OP_MEMBER_NAME: u32 = 6;
+const OP_TYPE_ARRAY: u32 = 28;
+const OP_TYPE_RUNTIME_ARRAY: u32 = 29;
+const OP_DECORATE: u32 = 71;
+const OP_MEMBER_DECORATE: u32 = 72;
+const DECORATION_ARRAY_STRIDE: u32 = 6;
+const DECORATION_OFFSET: u32 = 35;
+
+#[derive(Default)]
+struct Reflection {
+    names: HashMap<u32, String>,
+    member_names: HashMap<(u32, u32), String>,
+    member_offsets: HashMap<(u32, u32), u32>,
+    array_strides: HashMap<u32, u32>,
+    array_elements: Vec<(u32, u32)>,
+}
+
+fn spirv_string(words: &[u32]) -> String {
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).take_while(|&b| b != 0).collect();
+    String::from_utf8(bytes).expect("SPIR-V strings are UTF-8")
+}
+
+fn reflect(spirv: &[u32]) -> Reflection {
+    let mut r = Reflection::default();
+    let mut i = 5;
+    while i < spirv.len() {
+        let (count, op) = ((spirv[i] >> 16) as usize, spirv[i] & 0xffff);
+        let args = &spirv[i + 1..i + count];
+        match op {
+            OP_NAME => {
+                r.names.insert(args[0], spirv_string(&args[1..]));
+            }
+            OP_MEMBER_NAME => {
+                r.member_names.insert((args[0], args[1]), spirv_string(&args[2..]));
+            }
+            OP_MEMBER_DECORATE if args[2] == DECORATION_OFFSET => {
+                r.member_offsets.insert((args[0], args[1]), args[3]);
+            }
+            OP_DECORATE if args[1] == DECORATION_ARRAY_STRIDE => {
+                r.array_strides.insert(args[0], args[2]);
+            }
+            OP_TYPE_ARRAY | OP_TYPE_RUNTIME_ARRAY => r.array_elements.push((args[0], args[1])),
+            _ => {}
+        }
+        i += count.max(1);
+    }
+    r
+}
+
+macro_rules! rust_fields {
+    ($t:ty: $($f:ident),*) => {
+        (stringify!($t), std::mem::size_of::<$t>(), vec![$((stringify!($f).to_string(), std::mem::offset_of!($t, $f) as u32)),*])
+    };
+}
+
+fn check_layout(kernel: &str, defines: &[(&str, &str)]) -> usize {
+    let spirv = compile_kernel(kernel, defines).expect("kernel compiles");
+    let r = reflect(&spirv);
+    let structs = [
+        rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, pad),
+        rust_fields!(Triangle: v0, material, e1, emitter, e2, pad),
+        rust_fields!(BvhNode: lo, skip, hi, leaf),
+        rust_fields!(Emitter: triangle, select_pdf, alias_prob, alias),
+        rust_fields!(FrameParams: cam_position, cam_right, cam_up, cam_forward, scene_env, width, height, sample_offset,
+            samples_per_dispatch, max_depth, render_seed, flags, emitter_count),
+    ];
+    let mut checked = 0;
+    for (name, size, fields) in structs {
+        // glslang also emits an undecorated copy of each struct for locals; only the copies with
+        // explicit offsets describe memory.
+        let ids: Vec<u32> = r
+            .names
+            .iter()
+            .filter(|(id, n)| n.as_str() == name && r.member_offsets.contains_key(&(**id, 0)))
+            .map(|(&id, _)| id)
+            .collect();
+        assert!(!ids.is_empty(), "{kernel}: struct {name} with explicit layout not found in SPIR-V");
+        for id in ids {
+            let mut glsl: Vec<(String, u32)> = (0..)
+                .map_while(|m| Some((r.member_names.get(&(id, m))?.clone(), *r.member_offsets.get(&(id, m))?)))
+                .collect();
+            glsl.sort_by_key(|(_, o)| *o);
+            assert_eq!(glsl, fields, "{kernel}: member names/offsets of {name} (GLSL left, Rust right)");
+            for (array, _) in r.array_elements.iter().filter(|(_, element)| *element == id) {
+                let stride = r.array_strides[array];
+                assert_eq!(stride as usize, size, "{kernel}: array stride of {name}[] vs size_of::<{name}>()");
+            }
+            checked += 1;
+        }
+    }
+    checked
+}
+
+#[test]
+fn gpu_types_match_glsl_layout_in_storage_and_uniform_bindings() {
+    assert!(check_layout("pathtrace.comp", &[]) >= 5);
+    let uniform = [
+        ("SCENE_UNIFORM_BUFFERS", "1"),
+        ("SCENE_TRIANGLE_COUNT", "4"),
+        ("SCENE_NODE_COUNT", "3"),
+        ("SCENE_MATERIAL_COUNT", "2"),
+        ("SCENE_EMITTER_SLOTS", "1"),
+    ];
+    assert!(check_layout("pathtrace.comp", &uniform) >= 5);
+}

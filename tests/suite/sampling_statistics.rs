@@ -1,0 +1,197 @@
+//! Statistical tests of the Rust samplers (the GLSL twins are tied to them by the oracle tests):
+//! chi-square goodness of fit at the 1% level, and sample/pdf consistency.
+
+use std::f64::consts::PI;
+
+use glam::{Vec2, Vec3};
+use restir_pt::bsdf::{ggx_vndf_pdf, smith_g1};
+use restir_pt::bvh::intersect_triangle;
+use restir_pt::lights::{alias_select, sample_light};
+use restir_pt::sampling::{sample_cosine_hemisphere, sample_ggx_vndf, sample_triangle};
+
+use crate::common::TestRng;
+
+/// Upper 1% point of chi-square with `dof` degrees of freedom (Wilson-Hilferty; accurate to
+/// well under 1% for dof >= 10).
+pub fn chi_square_critical_1pct(dof: usize) -> f64 {
+    let k = dof as f64;
+    let z = 2.326_347_874;
+    k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3)
+}
+
+/// Pearson's statistic after pooling bins whose expected count is below 5; returns (chi2, dof).
+fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize) {
+    let (mut chi2, mut bins) = (0.0, 0);
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    for (&o, &e) in observed.iter().zip(expected) {
+        if e < 5.0 {
+            pool_o += o;
+            pool_e += e;
+        } else {
+            chi2 += (o - e).powi(2) / e;
+            bins += 1;
+        }
+    }
+    if pool_e > 0.0 {
+        chi2 += (pool_o - pool_e).powi(2) / pool_e.max(1e-9);
+        bins += 1;
+    }
+    (chi2, bins - 1)
+}
+
+fn assert_fits(what: &str, observed: &[f64], expected: &[f64]) {
+    let (chi2, dof) = chi_square(observed, expected);
+    let critical = chi_square_critical_1pct(dof);
+    assert!(chi2 < critical, "{what}: chi2 {chi2:.1} >= {critical:.1} ({dof} dof)");
+}
+
+const SAMPLES: usize = 1_000_000;
+
+#[test]
+fn sample_cosine_hemisphere_chi_square() {
+    let (nt, np) = (10, 20);
+    let mut observed = vec![0.0; nt * np];
+    let mut r = TestRng(31);
+    for _ in 0..SAMPLES {
+        let w = sample_cosine_hemisphere(Vec2::new(r.uniform(), r.uniform()));
+        let phi = (w.y.atan2(w.x) as f64 + 2.0 * PI) % (2.0 * PI);
+        let (i, j) = (
+            ((w.z as f64 * nt as f64) as usize).min(nt - 1),
+            ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1),
+        );
+        observed[i * np + j] += 1.0;
+    }
+    // P(cos in [a, b]) = b^2 - a^2, uniform in phi.
+    let expected: Vec<f64> = (0..nt * np)
+        .map(|k| {
+            let (a, b) = ((k / np) as f64 / nt as f64, (k / np + 1) as f64 / nt as f64);
+            SAMPLES as f64 * (b * b - a * a) / np as f64
+        })
+        .collect();
+    assert_fits("cosine hemisphere", &observed, &expected);
+}
+
+#[test]
+fn sample_ggx_vndf_chi_square() {
+    let (nt, np) = (12, 16);
+    for (alpha, theta_o) in [(0.1f32, 0.5f32), (0.5, 1.2), (0.9, 0.2)] {
+        let wo = Vec3::new(theta_o.sin(), 0.0, theta_o.cos());
+        let a2 = (alpha * alpha) as f64;
+        // Bins are uniform in x = tan^2 / (alpha^2 + tan^2), GGX's own CDF variable, so that even
+        // narrow lobes spread over many bins.
+        let theta_of = |x: f64| (a2 * x / (1.0 - x).max(1e-300)).sqrt().atan();
+        let mut observed = vec![0.0; nt * np];
+        let mut r = TestRng(41);
+        for _ in 0..SAMPLES {
+            let h = sample_ggx_vndf(wo, alpha, Vec2::new(r.uniform(), r.uniform()));
+            let t2 = ((1.0 - (h.z as f64).powi(2)).max(0.0)) / (h.z as f64).powi(2);
+            let x = t2 / (a2 + t2);
+            let phi = ((h.y as f64).atan2(h.x as f64) + 2.0 * PI) % (2.0 * PI);
+            let (i, j) = (
+                ((x * nt as f64) as usize).min(nt - 1),
+                ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1),
+            );
+            observed[i * np + j] += 1.0;
+        }
+        let sub = 12;
+        let expected: Vec<f64> = (0..nt * np)
+            .map(|k| {
+                let (i, j) = (k / np, k % np);
+                let (t0, t1) = (theta_of(i as f64 / nt as f64), theta_of((i + 1) as f64 / nt as f64).min(PI / 2.0));
+                let (p0, p1) = (2.0 * PI * j as f64 / np as f64, 2.0 * PI * (j + 1) as f64 / np as f64);
+                let mut sum = 0.0;
+                for a in 0..sub {
+                    for b in 0..sub {
+                        let theta = t0 + (t1 - t0) * (a as f64 + 0.5) / sub as f64;
+                        let phi = p0 + (p1 - p0) * (b as f64 + 0.5) / sub as f64;
+                        let h = Vec3::new(
+                            (theta.sin() * phi.cos()) as f32,
+                            (theta.sin() * phi.sin()) as f32,
+                            theta.cos() as f32,
+                        );
+                        sum += ggx_vndf_pdf(wo, h, alpha) as f64 * theta.sin();
+                    }
+                }
+                SAMPLES as f64 * sum * (t1 - t0) * (p1 - p0) / (sub * sub) as f64
+            })
+            .collect();
+        let total: f64 = expected.iter().sum::<f64>() / SAMPLES as f64;
+        assert!(
+            (total - 1.0).abs() < 2e-3,
+            "alpha {alpha}: VNDF integrates to {total}, G1 = {}",
+            smith_g1(wo, alpha)
+        );
+        assert_fits(&format!("GGX VNDF alpha {alpha} theta_o {theta_o}"), &observed, &expected);
+    }
+}
+
+#[test]
+fn sample_triangle_chi_square() {
+    let (na, nb) = (10, 10);
+    let mut observed = vec![0.0; na * nb];
+    let mut r = TestRng(51);
+    for _ in 0..SAMPLES {
+        let b = sample_triangle(Vec2::new(r.uniform(), r.uniform()));
+        // (1 - b1)^2 and b2 / (1 - b1) are both uniform for area-uniform points.
+        let x = (1.0 - b.x as f64).powi(2);
+        let y = b.y as f64 / (1.0 - b.x as f64).max(1e-12);
+        observed[((x * na as f64) as usize).min(na - 1) * nb + ((y * nb as f64) as usize).min(nb - 1)] += 1.0;
+    }
+    let expected = vec![SAMPLES as f64 / (na * nb) as f64; na * nb];
+    assert_fits("triangle area sampling", &observed, &expected);
+}
+
+#[test]
+fn light_selection_chi_square_follows_emitter_power() {
+    let scene = crate::bvh_oracle::random_scene(12);
+    let n = scene.emitters.len();
+    let mut observed = vec![0.0; n];
+    let mut r = TestRng(61);
+    for _ in 0..SAMPLES {
+        observed[alias_select(&scene.emitters, r.uniform(), n as u32) as usize] += 1.0;
+    }
+    let expected: Vec<f64> = scene.emitters.iter().map(|e| e.select_pdf as f64 * SAMPLES as f64).collect();
+    assert!((scene.emitters.iter().map(|e| e.select_pdf as f64).sum::<f64>() - 1.0).abs() < 1e-5);
+    assert_fits("alias-table emitter selection", &observed, &expected);
+}
+
+/// E[1 / pdf] over light samples equals the total solid angle the emitters subtend (each
+/// counted once per emitter), which uniform sphere sampling estimates independently.
+#[test]
+fn sample_light_pdf_is_consistent_with_solid_angle() {
+    let mut scene = crate::bvh_oracle::random_scene(13);
+    scene.environment = Vec3::ZERO;
+    scene.env_select_prob = 0.0;
+    let p = Vec3::new(0.3, -0.2, 0.1);
+    let mut r = TestRng(71);
+    let n = 400_000;
+    let light: Vec<f64> = (0..n)
+        .map(|_| {
+            let ls = sample_light(&scene, p, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
+            if ls.pdf > 0.0 {
+                1.0 / ls.pdf as f64
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let emitters: Vec<_> = scene.emitters.iter().map(|e| scene.triangles[e.triangle as usize]).collect();
+    let sphere: Vec<f64> = (0..n)
+        .map(|_| {
+            let d = r.unit_vector();
+            4.0 * PI * emitters.iter().filter(|t| intersect_triangle(p, d, t, 1e30).is_some()).count() as f64
+        })
+        .collect();
+    let stats = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        (
+            m,
+            v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() as f64 - 1.0) / v.len() as f64,
+        )
+    };
+    let ((a, va), (b, vb)) = (stats(&light), stats(&sphere));
+    assert!(
+        (a - b).abs() < 4.0 * (va + vb).sqrt(),
+        "light sampling {a:.5} vs sphere sampling {b:.5} sr"
+    );
+}

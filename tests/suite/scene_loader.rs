@@ -1,0 +1,163 @@
+//! The glTF loader checks the data, not only the JSON: each problem is an error or a warning
+//! that names the file.
+
+use glam::Vec3;
+use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+use restir_pt::scene::load_scene;
+use serde_json::{json, Value};
+
+use crate::common::{repo_path, temp_file};
+
+/// A lit quad and a camera; `edit` may change the JSON before it is written.
+fn scene_file(name: &str, mesh: MeshData, emitter: Option<MeshData>, edit: impl FnOnce(&mut Value)) -> std::path::PathBuf {
+    let mut b = GltfBuilder::default();
+    let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
+    let m = b.mesh("geometry", &mesh, grey);
+    b.instance("geometry", m, 0.0, Vec3::ZERO);
+    if let Some(e) = emitter {
+        let light = b.material("light", MaterialSpec::emitter(Vec3::splat(5.0)));
+        let l = b.mesh("light", &e, light);
+        b.instance("light", l, 0.0, Vec3::ZERO);
+    }
+    b.camera("camera", Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, 0.8);
+    let mut value: Value = serde_json::from_str(&b.finish("test", Vec3::ZERO)).unwrap();
+    edit(&mut value);
+    temp_file(name, serde_json::to_string(&value).unwrap().as_bytes())
+}
+
+fn floor() -> MeshData {
+    MeshData::quad(Vec3::new(-1.0, 0.0, -1.0), Vec3::Z * 2.0, Vec3::X * 2.0)
+}
+
+fn lamp() -> MeshData {
+    MeshData::quad(Vec3::new(-0.2, 1.0, -0.2), Vec3::X * 0.4, Vec3::Z * 0.4)
+}
+
+fn load_error(path: &std::path::Path) -> String {
+    format!("{:#}", load_scene(path).err().expect("the scene must be rejected"))
+}
+
+#[test]
+fn loader_reads_the_bundled_cornell_box() {
+    let scene = load_scene(&repo_path("scenes/cornell.gltf")).unwrap();
+    assert_eq!(scene.triangles.len(), 36);
+    assert_eq!(scene.emitters.len(), 2);
+    assert_eq!(scene.cameras.len(), 8);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let light_power = 0.47 * 0.38 * std::f32::consts::PI * restir_pt::scene::luminance(Vec3::new(17.0, 12.0, 4.0));
+    assert!((scene.emitter_power - light_power).abs() < 1e-3 * light_power);
+}
+
+#[test]
+fn loader_rejects_nan_positions_and_bad_indices_naming_the_file() {
+    let mut nan = floor();
+    nan.positions[2].y = f32::NAN;
+    let path = scene_file("nan.gltf", nan, Some(lamp()), |_| {});
+    let e = load_error(&path);
+    assert!(e.contains("nan.gltf") && e.contains("NaN"), "{e}");
+
+    let mut bad = floor();
+    bad.indices[4] = 77;
+    let path = scene_file("index.gltf", bad, Some(lamp()), |_| {});
+    let e = load_error(&path);
+    assert!(e.contains("index.gltf") && e.contains("index 77 is out of range"), "{e}");
+}
+
+#[test]
+fn loader_drops_degenerate_triangles_and_zero_area_emitters_with_warnings() {
+    let mut geometry = floor();
+    geometry.positions.extend([Vec3::ZERO, Vec3::X, Vec3::X * 2.0]);
+    geometry.indices.extend([4, 5, 6]);
+    let flat_lamp = MeshData {
+        positions: vec![Vec3::Y, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)],
+        indices: vec![0, 1, 2],
+    };
+    let path = scene_file("degenerate.gltf", geometry, Some(lamp().merged(&flat_lamp)), |_| {});
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.triangles.len(), 4);
+    assert_eq!(scene.emitters.len(), 2);
+    let warnings = scene.warnings.join("\n");
+    assert!(
+        warnings.contains("degenerate.gltf") && warnings.contains("2 degenerate"),
+        "{warnings}"
+    );
+    assert!(warnings.contains("1 zero-area emitter"), "{warnings}");
+}
+
+#[test]
+fn loader_rejects_scenes_without_light_or_triangles() {
+    let path = scene_file("dark.gltf", floor(), None, |_| {});
+    assert!(load_error(&path).contains("no light"));
+    let empty = MeshData {
+        positions: vec![Vec3::ZERO; 3],
+        indices: vec![0, 1, 2],
+    };
+    let path = scene_file("empty.gltf", empty, None, |v| {
+        v["scenes"][0]["extras"] = json!({ "environment": [1, 1, 1] })
+    });
+    assert!(load_error(&path).contains("no renderable triangles"));
+}
+
+#[test]
+fn loader_reads_environment_and_rejects_bad_values() {
+    let path = scene_file("env.gltf", floor(), None, |v| {
+        v["scenes"][0]["extras"] = json!({ "environment": [0.5, 1.0, 2.0] })
+    });
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.environment, Vec3::new(0.5, 1.0, 2.0));
+    assert_eq!(scene.env_select_prob, 1.0);
+    let path = scene_file("badenv.gltf", floor(), None, |v| {
+        v["scenes"][0]["extras"] = json!({ "environment": [-1, 0, 0] })
+    });
+    assert!(load_error(&path).contains("environment"));
+    let path = scene_file("badmat.gltf", floor(), Some(lamp()), |v| {
+        v["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] = json!(-0.5)
+    });
+    let e = load_error(&path);
+    assert!(
+        e.contains("badmat.gltf") && e.contains("grey") && e.contains("roughnessFactor"),
+        "{e}"
+    );
+}
+
+#[test]
+fn loader_warns_about_textures_and_rejects_unsupported_required_extensions() {
+    let path = scene_file("texture.gltf", floor(), Some(lamp()), |v| {
+        v["images"] = json!([{ "uri": "missing.png" }]);
+        v["textures"] = json!([{ "source": 0 }]);
+        v["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+    });
+    let scene = load_scene(&path).unwrap();
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("texture.gltf") && w.contains("base colour texture ignored")),
+        "{:?}",
+        scene.warnings
+    );
+    let path = scene_file("required.gltf", floor(), Some(lamp()), |v| {
+        v["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+        v["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    });
+    let e = load_error(&path);
+    assert!(e.contains("required.gltf") && e.contains("KHR_draco_mesh_compression"), "{e}");
+}
+
+#[test]
+fn loader_applies_node_transforms_and_mirroring_flips_the_front_face() {
+    let path = scene_file("mirrored.gltf", floor(), Some(lamp()), |v| {
+        v["nodes"][1]["scale"] = json!([1.0, -1.0, 1.0]);
+        v["nodes"][1]["translation"] = json!([0.0, 3.0, 0.0]);
+    });
+    let scene = load_scene(&path).unwrap();
+    let light = scene
+        .triangles
+        .iter()
+        .find(|t| t.emitter != restir_pt::gpu_types::NO_EMITTER)
+        .unwrap();
+    let v = light.vertices();
+    assert!(v.iter().all(|p| (p.y - 2.0).abs() < 1e-6), "light moved to y = -1 + 3: {v:?}");
+    // The lamp faced down (-y); mirrored in y it faces up, and the winding must say so.
+    assert!(light.normal_area2().y > 0.0);
+}
