@@ -112,6 +112,13 @@ impl MeshData {
         MeshData { positions, indices }
     }
 
+    /// The same surface with the other face in front (e.g. a box seen from inside).
+    pub fn flipped(&self) -> MeshData {
+        let mut out = self.clone();
+        out.indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
+        out
+    }
+
     pub fn merged(&self, other: &MeshData) -> MeshData {
         let base = self.positions.len() as u32;
         let mut out = self.clone();

@@ -86,7 +86,7 @@ impl Scene {
             materials: parts.materials,
             material_names: parts.material_names,
             emitters,
-            emitter_power: powers.iter().sum(),
+            emitter_power: powers.iter().fold(0.0, |a, p| a + p),
             environment: parts.environment,
             env_select_prob,
             cameras: parts.cameras,

@@ -12,3 +12,4 @@ mod rng_oracle;
 mod sampling_oracle;
 mod sampling_statistics;
 mod scene_loader;
+mod scenes;
