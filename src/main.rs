@@ -68,9 +68,16 @@ struct RenderCmd {
     /// Russian roulette from the third segment on (survival = max throughput, at most 0.95).
     #[arg(long, value_enum, default_value_t = Toggle::On)]
     russian_roulette: Toggle,
-    /// Index of the glTF camera to render from (scene order).
+    /// Index of the glTF camera to render from (scene order); with --frames, the first pose.
     #[arg(long, default_value_t = 0)]
     camera: usize,
+    /// Render F frames along the scene's camera path: frame k uses camera (--camera + k).
+    /// The last frame goes to --out; every frame too with --out-dir.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    /// Folder for every frame of --frames (frame_0000.exr/png, ...).
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
     /// Linear float RGB EXR output (default: out/<scene>.exr).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -137,6 +144,8 @@ fn main() -> ExitCode {
             seed: r.seed,
             russian_roulette: r.russian_roulette.on(),
             camera: r.camera,
+            frames: r.frames,
+            out_dir: r.out_dir,
             out: r.out,
             png: r.png,
             variance: r.variance,

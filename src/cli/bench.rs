@@ -65,9 +65,9 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     let mut rates = Vec::new();
     let mut gpu_ms = Vec::new();
     // Run 0 warms up: llvmpipe compiles the pipeline at its first dispatch.
+    let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
     for run in 0..=runs {
-        let mut tracer = PathTracer::new(
-            &ctx,
+        tracer.restart(
             &scene,
             &RenderSettings {
                 seed: run,
@@ -82,6 +82,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
             gpu_ms.push(stats.gpu_ms);
         }
     }
+    drop(tracer);
     finish_device(&ctx)?;
     let report = BenchReport {
         device: ctx.info.name.clone(),

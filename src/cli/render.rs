@@ -1,10 +1,10 @@
 //! `restir-pt render`: progressive path tracing to EXR/PNG with a one-line summary.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use anyhow::{Context as _, Result};
+use anyhow::{bail, Context as _, Result};
 use serde::Serialize;
 
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
@@ -20,6 +20,8 @@ pub struct RenderArgs {
     pub seed: u32,
     pub russian_roulette: bool,
     pub camera: usize,
+    pub frames: u32,
+    pub out_dir: Option<PathBuf>,
     pub out: Option<PathBuf>,
     pub png: Option<PathBuf>,
     pub variance: Option<PathBuf>,
@@ -79,9 +81,29 @@ fn interrupt_flag() -> Arc<AtomicBool> {
     .clone()
 }
 
+fn create_parent(file: &Path) -> Result<()> {
+    match file.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) => std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display())),
+        None => Ok(()),
+    }
+}
+
 pub fn render(args: RenderArgs) -> Result<()> {
     let path = scene_path(args.scene.as_deref());
     let scene = load_with_warnings(&path)?;
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let last_camera = args.camera + args.frames as usize - 1;
+    if last_camera >= scene.cameras.len() {
+        bail!(
+            "{}: --frames {} from --camera {} needs camera {last_camera}, but the scene has {} camera(s)",
+            path.display(),
+            args.frames,
+            args.camera,
+            scene.cameras.len()
+        );
+    }
     let settings = RenderSettings {
         width: args.width,
         height: args.height,
@@ -102,42 +124,71 @@ pub fn render(args: RenderArgs) -> Result<()> {
         .into_iter()
         .flatten()
     {
-        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
-        }
+        create_parent(file)?;
+    }
+    if let Some(dir) = &args.out_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     }
 
     let ctx = open_device(&args.device)?;
+    let interrupt = interrupt_flag();
+    let mut report = None;
     let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
-    let bar = progress_bar(settings.spp);
-    let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt_flag())?;
-    bar.finish_and_clear();
-    if stats.interrupted {
-        eprintln!("interrupted: writing the {} spp accumulated so far", stats.spp);
-    }
-    let image = tracer.image()?;
-    write_exr(&out, image.width, image.height, &image.mean)?;
-    write_png(&png, &image)?;
-    if let Some(v) = &args.variance {
-        write_exr(v, image.width, image.height, &image.variance)?;
+    for frame in 0..args.frames {
+        tracer.restart(
+            &scene,
+            &RenderSettings {
+                camera: args.camera + frame as usize,
+                ..settings.clone()
+            },
+        )?;
+        let bar = progress_bar(settings.spp);
+        let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
+        bar.finish_and_clear();
+        let image = tracer.image()?;
+        if let Some(dir) = &args.out_dir {
+            let name = format!("frame_{frame:04}");
+            write_exr(&dir.join(format!("{name}.exr")), image.width, image.height, &image.mean)?;
+            write_png(&dir.join(format!("{name}.png")), &image)?;
+        }
+        let frame_report = RenderReport {
+            device: ctx.info.name.clone(),
+            scene: path.display().to_string(),
+            width: settings.width,
+            height: settings.height,
+            spp: stats.spp,
+            max_depth: settings.max_depth,
+            gpu_ms: stats.gpu_ms,
+            wall_ms: stats.wall_ms,
+            paths_per_second: stats.paths_per_second(settings.pixel_count()),
+        };
+        println!(
+            "{}{}",
+            if args.frames > 1 {
+                format!("frame {frame} | ")
+            } else {
+                String::new()
+            },
+            frame_report.summary_line()
+        );
+        let last = frame + 1 == args.frames || stats.interrupted;
+        if stats.interrupted {
+            eprintln!("interrupted: writing the {} spp of frame {frame} accumulated so far", stats.spp);
+        }
+        if last {
+            write_exr(&out, image.width, image.height, &image.mean)?;
+            write_png(&png, &image)?;
+            if let Some(v) = &args.variance {
+                write_exr(v, image.width, image.height, &image.variance)?;
+            }
+            report = Some(frame_report);
+            break;
+        }
     }
     drop(tracer);
     finish_device(&ctx)?;
-
-    let report = RenderReport {
-        device: ctx.info.name.clone(),
-        scene: path.display().to_string(),
-        width: settings.width,
-        height: settings.height,
-        spp: stats.spp,
-        max_depth: settings.max_depth,
-        gpu_ms: stats.gpu_ms,
-        wall_ms: stats.wall_ms,
-        paths_per_second: stats.paths_per_second(settings.pixel_count()),
-    };
-    println!("{}", report.summary_line());
-    if let Some(r) = &args.report {
-        std::fs::write(r, serde_json::to_string_pretty(&report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
+    if let (Some(r), Some(report)) = (&args.report, &report) {
+        std::fs::write(r, serde_json::to_string_pretty(report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
     }
     eprintln!("wrote {} and {}", out.display(), png.display());
     Ok(())

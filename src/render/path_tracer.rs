@@ -92,6 +92,27 @@ impl PathTracer {
         })
     }
 
+    /// Starts over with `settings` (another camera, seed, spp or depth) and cleared sums, keeping
+    /// the compiled kernel; the resolution must stay the same.
+    pub fn restart(&mut self, scene: &Scene, settings: &RenderSettings) -> Result<()> {
+        settings.validate(scene)?;
+        if (settings.width, settings.height) != (self.settings.width, self.settings.height) {
+            anyhow::bail!(
+                "restart cannot change the resolution ({}x{} to {}x{})",
+                self.settings.width,
+                self.settings.height,
+                settings.width,
+                settings.height
+            );
+        }
+        self.accum.fill(0)?;
+        self.accum_sq.fill(0)?;
+        self.base_params = settings.frame_params(scene);
+        self.settings = settings.clone();
+        self.samples_done = 0;
+        Ok(())
+    }
+
     /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the
     /// device has no timestamps) and the most loop iterations any subgroup ran.
     pub fn dispatch(&mut self, samples: u32) -> Result<(Option<f64>, u32)> {

@@ -134,3 +134,38 @@ fn cli_max_depth_one_shows_only_emitters() {
         .iter()
         .all(|p| p.max_element() == 0.0 || ((p.x / p.z - 17.0 / 4.0).abs() < 1e-3 && p.x <= 17.0 + 1e-3)));
 }
+
+#[test]
+fn cli_frames_render_along_the_camera_path() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().join("frames");
+    let last = dir.join("last.exr");
+    let (code, stdout, stderr) = restir_pt(&[
+        "render",
+        "--frames",
+        "3",
+        "--camera",
+        "2",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "2",
+        "--validate",
+        "--out-dir",
+        dir.to_str().unwrap(),
+        "--out",
+        last.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(stdout.lines().filter(|l| l.starts_with("frame ")).count(), 3, "{stdout}");
+    for k in 0..3 {
+        assert!(dir.join(format!("frame_{k:04}.exr")).exists() && dir.join(format!("frame_{k:04}.png")).exists());
+    }
+    // The last frame is also the --out image.
+    assert_eq!(std::fs::read(dir.join("frame_0002.exr")).unwrap(), std::fs::read(&last).unwrap());
+    assert_clean_failure(
+        &["render", "--frames", "9", "--width", "8", "--height", "8"],
+        &["--frames 9", "8 camera(s)"],
+    );
+}
