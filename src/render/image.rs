@@ -12,12 +12,18 @@ pub struct Image {
 }
 
 impl Image {
-    /// From per-pixel sums of L (rgb) and counts (w), and sums of L^2.
+    /// From per-pixel sums of L (rgb) and counts (w), and sums of L^2. A pixel no sample reached
+    /// is NaN, never a plausible-looking 0.
     pub fn from_sums(width: u32, height: u32, sums: &[[f32; 4]], sums_sq: &[[f32; 4]]) -> Image {
         let mut mean = Vec::with_capacity(sums.len());
         let mut variance = Vec::with_capacity(sums.len());
         for (s, q) in sums.iter().zip(sums_sq) {
-            let n = s[3].max(1.0);
+            if s[3] <= 0.0 {
+                mean.push(Vec3::NAN);
+                variance.push(Vec3::NAN);
+                continue;
+            }
+            let n = s[3];
             let m = Vec3::new(s[0], s[1], s[2]) / n;
             let m2 = Vec3::new(q[0], q[1], q[2]) / n;
             let sample_var = if n > 1.0 {

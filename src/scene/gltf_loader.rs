@@ -37,9 +37,26 @@ fn problem(path: &Path, msg: impl std::fmt::Display) -> anyhow::Error {
 /// Loads a glTF or GLB file. Errors are one line naming the file and the problem.
 pub fn load_scene(path: &Path) -> Result<Scene> {
     let bytes = std::fs::read(path).map_err(|e| problem(path, format!("cannot read the file: {e}")))?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| problem(path, format!("invalid glTF: {e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
-    let buffers = gltf::import_buffers(&gltf.document, Some(&base), gltf.blob.clone())
+    load_scene_from_bytes(&bytes, Some(&base), path)
+}
+
+/// Loads glTF or GLB bytes; external buffers resolve against `base` (none: only embedded data).
+/// `path` names the input in messages.
+pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> Result<Scene> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
+        let e = e.to_string();
+        // The gltf crate prefixes validation errors itself; JSON errors need the context.
+        problem(
+            path,
+            if e.starts_with("invalid glTF") {
+                e
+            } else {
+                format!("invalid glTF: {e}")
+            },
+        )
+    })?;
+    let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
         .map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
     for (i, (data, buffer)) in buffers.iter().zip(gltf.document.buffers()).enumerate() {
         if data.len() < buffer.length() {
@@ -247,7 +264,12 @@ impl Loader<'_> {
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let positions: Vec<Vec3> = reader
                 .read_positions()
-                .ok_or_else(|| problem(self.path, format!("mesh {}: a primitive has no POSITION data", mesh.index())))?
+                .ok_or_else(|| {
+                    problem(
+                        self.path,
+                        format!("mesh {}: POSITION data is missing or does not fit its buffer", mesh.index()),
+                    )
+                })?
                 .map(Vec3::from)
                 .collect();
             if let Some(i) = positions.iter().position(|p| !p.is_finite()) {

@@ -4,7 +4,7 @@ mod camera;
 mod gltf_loader;
 
 pub use camera::Camera;
-pub use gltf_loader::load_scene;
+pub use gltf_loader::{load_scene, load_scene_from_bytes};
 
 use glam::Vec3;
 use std::path::PathBuf;

@@ -52,7 +52,13 @@ impl Buffer {
             .size(size)
             .usage(flags)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let handle = unsafe { ctx.device.create_buffer(&info, None) }.map_err(vk_error("creating a buffer"))?;
+        let handle = unsafe { ctx.device.create_buffer(&info, None) }.map_err(|e| match vk_error("creating a buffer")(e) {
+            GpuError::OutOfMemory { .. } => GpuError::OutOfMemory {
+                what: name.to_string(),
+                bytes: size,
+            },
+            other => other,
+        })?;
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(handle) };
         let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
             name,

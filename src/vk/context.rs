@@ -3,7 +3,7 @@
 
 use std::ffi::{c_void, CStr, CString};
 use std::mem::ManuallyDrop;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
@@ -39,10 +39,17 @@ pub struct DeviceInfo {
     pub loop_iteration_limit: Option<u32>,
 }
 
-/// Collects the validation layer's output so that tests can fail on it.
+/// Collects the validation layer's output so that tests can fail on it. It may outlive the
+/// context: leaks are reported while the device is destroyed.
 #[derive(Default)]
-struct ValidationLog {
+pub struct ValidationLog {
     errors: Mutex<Vec<String>>,
+}
+
+impl ValidationLog {
+    pub fn messages(&self) -> Vec<String> {
+        self.errors.lock().map(|e| e.clone()).unwrap_or_default()
+    }
 }
 
 unsafe extern "system" fn debug_callback(
@@ -76,7 +83,7 @@ pub struct Context {
     pub physical_device: vk::PhysicalDevice,
     pub info: DeviceInfo,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-    validation_log: Box<ValidationLog>,
+    validation_log: Arc<ValidationLog>,
     pub instance: ash::Instance,
     _entry: ash::Entry,
 }
@@ -124,7 +131,7 @@ impl Context {
             vec![]
         };
 
-        let validation_log = Box::<ValidationLog>::default();
+        let validation_log = Arc::<ValidationLog>::default();
         let severity = vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING;
         let types = vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
             | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
@@ -225,7 +232,12 @@ impl Context {
 
     /// Every validation message (errors and warnings) reported so far.
     pub fn validation_messages(&self) -> Vec<String> {
-        self.validation_log.errors.lock().map(|e| e.clone()).unwrap_or_default()
+        self.validation_log.messages()
+    }
+
+    /// The log itself, to read after the context is dropped (leaked objects are reported then).
+    pub fn validation_log(&self) -> Arc<ValidationLog> {
+        self.validation_log.clone()
     }
 
     /// Fails if the validation layer has reported anything; tests call this at their end.

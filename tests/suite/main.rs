@@ -9,6 +9,7 @@ mod cli;
 mod furnace;
 mod layout;
 mod rng_oracle;
+mod robustness;
 mod sampling_oracle;
 mod sampling_statistics;
 mod scene_loader;
