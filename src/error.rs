@@ -7,6 +7,8 @@ use ash::vk;
 pub enum GpuError {
     #[error("the Vulkan device was lost (VK_ERROR_DEVICE_LOST) during {during}; the GPU work was abandoned")]
     DeviceLost { during: &'static str },
+    #[error("a GPU submission did not finish within {seconds} s; the device is considered hung")]
+    Timeout { seconds: u64 },
     #[error("out of GPU memory while allocating {what} ({bytes} bytes)")]
     OutOfMemory { what: String, bytes: u64 },
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per storage-buffer binding (maxStorageBufferRange)")]

@@ -58,10 +58,6 @@ pub struct MeshData {
 }
 
 impl MeshData {
-    pub fn triangle_count(&self) -> usize {
-        self.indices.len() / 3
-    }
-
     /// A quad with corners c, c+a, c+a+b, c+b; its front faces along a x b.
     pub fn quad(c: Vec3, a: Vec3, b: Vec3) -> MeshData {
         MeshData {

@@ -42,10 +42,6 @@ impl Image {
         }
     }
 
-    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
-        self.mean[(y * self.width + x) as usize]
-    }
-
     pub fn non_finite_count(&self) -> usize {
         self.mean.iter().filter(|p| !p.is_finite()).count()
     }

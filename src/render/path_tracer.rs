@@ -28,7 +28,6 @@ pub struct RenderStats {
     pub spp: u32,
     pub gpu_ms: f64,
     pub wall_ms: f64,
-    pub submissions: u32,
     /// True if the render stopped early on request (Ctrl-C); the image holds what was done.
     pub interrupted: bool,
 }
@@ -166,7 +165,6 @@ impl PathTracer {
     pub fn render(&mut self, progress: &dyn Fn(u32), cancel: &AtomicBool) -> Result<RenderStats> {
         let start = Instant::now();
         let mut gpu_ms = 0.0;
-        let mut submissions = 0;
         let mut chunk = 1u32;
         let mut interrupted = false;
         let target_ms = if self.ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU {
@@ -184,7 +182,6 @@ impl PathTracer {
             let (ms, iterations) = self.dispatch(samples)?;
             let ms = ms.unwrap_or_else(|| t0.elapsed().as_secs_f64() * 1e3);
             gpu_ms += ms;
-            submissions += 1;
             progress(self.samples_done);
             let per_sample = ms / samples as f64;
             chunk = ((target_ms / per_sample.max(1e-3)) as u32)
@@ -195,7 +192,6 @@ impl PathTracer {
             spp: self.samples_done,
             gpu_ms,
             wall_ms: start.elapsed().as_secs_f64() * 1e3,
-            submissions,
             interrupted,
         })
     }

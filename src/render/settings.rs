@@ -5,7 +5,8 @@ use anyhow::{bail, Result};
 use crate::gpu_types::{FrameParams, FLAG_RUSSIAN_ROULETTE};
 use crate::scene::Scene;
 
-/// Sides beyond this are refused: per-pixel indices are u32 and workgroup counts are bounded.
+/// Sides beyond this are refused: per-pixel indices stay far inside u32, and 8x8 workgroups
+/// stay within 8192 per axis, below the 65535 every Vulkan device supports.
 pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
 pub const MAX_PIXELS: u64 = 1 << 26;
 

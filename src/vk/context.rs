@@ -31,7 +31,6 @@ pub struct DeviceInfo {
     pub device_type: vk::PhysicalDeviceType,
     pub max_storage_buffer_range: u64,
     pub max_uniform_buffer_range: u64,
-    pub max_compute_workgroup_count: [u32; 3],
     pub timestamp_period_ns: f32,
     pub timestamps_supported: bool,
     /// Iterations each loop of one shader invocation may run in total before the driver silently
@@ -132,46 +131,37 @@ impl Context {
         };
 
         let validation_log = Arc::<ValidationLog>::default();
-        let severity = vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING;
-        let types = vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-            | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-            | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE;
         let log_ptr = &*validation_log as *const ValidationLog as *mut c_void;
-        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-            .message_severity(severity)
-            .message_type(types & !vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE)
-            .pfn_user_callback(Some(debug_callback))
-            .user_data(log_ptr);
+        let messenger_info = || {
+            vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
+                .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(log_ptr)
+        };
+        let mut instance_messenger = messenger_info();
         let mut instance_info = vk::InstanceCreateInfo::default()
             .application_info(&app_info)
             .enabled_layer_names(&layer_ptrs)
             .enabled_extension_names(&ext_ptrs);
         if validation {
             // Chained so that messages from instance creation itself are caught too.
-            instance_info = instance_info.push_next(&mut messenger_info);
+            instance_info = instance_info.push_next(&mut instance_messenger);
         }
         let instance = unsafe { entry.create_instance(&instance_info, None) }
             .map_err(|e| anyhow!("cannot create a Vulkan instance: {e:?} (is a Vulkan driver such as mesa-vulkan-drivers installed?)"))?;
 
-        let debug = if validation {
-            let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
-            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-                .message_severity(severity)
-                .message_type(types & !vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE)
-                .pfn_user_callback(Some(debug_callback))
-                .user_data(log_ptr);
-            let messenger =
-                unsafe { loader.create_debug_utils_messenger(&info, None) }.map_err(vk_error("creating the debug messenger"))?;
-            Some((loader, messenger))
-        } else {
-            None
-        };
-
         // From here on a failure must destroy the instance; the guard does that until ownership moves.
-        let guard = InstanceGuard {
+        let mut guard = InstanceGuard {
             instance: Some(instance),
-            debug,
+            debug: None,
         };
+        if validation {
+            let loader = ash::ext::debug_utils::Instance::new(&entry, guard.instance());
+            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info(), None) }
+                .map_err(vk_error("creating the debug messenger"))?;
+            guard.debug = Some((loader, messenger));
+        }
         let (physical_device, queue_family, info) = pick_device(guard.instance(), options.device.as_deref())?;
 
         let priorities = [1.0f32];
@@ -281,8 +271,8 @@ impl Context {
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
             let submitted = unsafe { self.device.queue_submit(self.queue, &submit, fence) }.map_err(vk_error("submitting GPU work"));
             let waited = submitted.and_then(|_| match unsafe { self.device.wait_for_fences(&[fence], true, FENCE_TIMEOUT_NS) } {
-                Err(vk::Result::TIMEOUT) => Err(GpuError::DeviceLost {
-                    during: "a GPU submission that exceeded 120 s",
+                Err(vk::Result::TIMEOUT) => Err(GpuError::Timeout {
+                    seconds: FENCE_TIMEOUT_NS / 1_000_000_000,
                 }),
                 other => other.map_err(vk_error("waiting for GPU work")),
             });
@@ -405,7 +395,6 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
         device_type: props.device_type,
         max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
         max_uniform_buffer_range: props.limits.max_uniform_buffer_range as u64,
-        max_compute_workgroup_count: props.limits.max_compute_work_group_count,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamps_supported: timestamp_bits > 0 && props.limits.timestamp_compute_and_graphics == vk::TRUE,
         loop_iteration_limit: device_name(&props).contains("llvmpipe").then_some(LLVMPIPE_LOOP_LIMIT),

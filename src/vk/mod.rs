@@ -9,5 +9,5 @@ mod timer;
 pub use buffer::{Buffer, BufferUsage};
 pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
 pub use kernel::{record_compute_barrier, Binding, Kernel};
-pub use shader::{compile_kernel, glsl_source, GLSL_SOURCES};
+pub use shader::{compile_kernel, glsl_source};
 pub use timer::PassTimer;
