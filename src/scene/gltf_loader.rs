@@ -44,18 +44,7 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 /// Loads glTF or GLB bytes; external buffers resolve against `base` (none: only embedded data).
 /// `path` names the input in messages.
 pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> Result<Scene> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
-        let e = e.to_string();
-        // The gltf crate prefixes validation errors itself; JSON errors need the context.
-        problem(
-            path,
-            if e.starts_with("invalid glTF") {
-                e
-            } else {
-                format!("invalid glTF: {e}")
-            },
-        )
-    })?;
+    let gltf = parse_gltf(bytes, path)?;
     let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
         .map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
     for (i, (data, buffer)) in buffers.iter().zip(gltf.document.buffers()).enumerate() {
@@ -85,6 +74,32 @@ pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> 
     loader.walk_nodes(&scene)?;
     let environment = scene_environment(path, &scene)?;
     loader.finish(environment)
+}
+
+fn invalid_gltf(path: &Path, e: gltf::Error) -> anyhow::Error {
+    let e = e.to_string();
+    // The gltf crate prefixes validation errors itself; JSON errors need the context.
+    problem(path, if e.starts_with("invalid glTF") { e } else { format!("invalid glTF: {e}") })
+}
+
+/// Parses and validates glTF or GLB. gltf-json's validation indexes a primitive's POSITION
+/// accessor before checking that it exists (a panic on crafted input, found by fuzzing), so those
+/// indices are checked here first.
+fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
+    use gltf::json::{mesh::Semantic, validation::Checked};
+    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid_gltf(path, e))?;
+    let root = unchecked.document.into_json();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for primitive in &mesh.primitives {
+            if let Some(index) = primitive.attributes.get(&Checked::Valid(Semantic::Positions)) {
+                if index.value() >= root.accessors.len() {
+                    bail!(problem(path, format!("mesh {m}: POSITION names accessor {}, but there are {}", index.value(), root.accessors.len())));
+                }
+            }
+        }
+    }
+    let document = gltf::Document::from_json(root).map_err(|e| invalid_gltf(path, e))?;
+    Ok(gltf::Gltf { document, blob: unchecked.blob })
 }
 
 fn scene_environment(path: &Path, scene: &gltf::Scene) -> Result<Vec3> {

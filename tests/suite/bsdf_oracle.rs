@@ -5,7 +5,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::bsdf::*;
 use restir_pt::gpu_types::Material;
 
-use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_oracle, TestRng};
 
 /// Relative agreement of values; GGX at small alpha and grazing angles amplifies ulp differences.
 const TOL: f32 = 1e-3;
@@ -46,12 +46,6 @@ fn near_decision(m: &Material, n: Vec3, wo: Vec3, u: Vec4) -> bool {
         || cos_o.abs() < 1e-3
 }
 
-fn assert_close3(what: &str, i: usize, a: Vec3, b: Vec3, m: &Material) {
-    for k in 0..3 {
-        assert!(close(a[k], b[k], TOL), "{what} item {i}: GLSL {a} vs Rust {b} for {m:?}");
-    }
-}
-
 #[test]
 fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
     let ctx = gpu();
@@ -87,7 +81,7 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
             inputs[4 * i + 3],
         );
         let (f, pdf) = bsdf_eval_pdf(m, n, wo, wi);
-        assert_close3("bsdf_eval_pdf f", i, out[3 * i].truncate(), f, m);
+        assert_vec3_close(format_args!("bsdf_eval_pdf f item {i} for {m:?}"), out[3 * i].truncate(), f, TOL);
         assert!(
             close(out[3 * i].w, pdf, TOL),
             "bsdf_eval_pdf pdf item {i}: GLSL {} vs Rust {pdf}",
@@ -102,14 +96,24 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
         assert_eq!(lobe, s.lobe, "bsdf_sample lobe item {i} for {m:?}");
         if s.lobe != LOBE_NONE {
             sampled += 1;
-            assert_close3("bsdf_sample wi", i, out[3 * i + 1].truncate(), s.wi, m);
+            assert_vec3_close(
+                format_args!("bsdf_sample wi item {i} for {m:?}"),
+                out[3 * i + 1].truncate(),
+                s.wi,
+                TOL,
+            );
             assert!(
                 close(out[3 * i + 1].w, s.pdf, TOL),
                 "bsdf_sample pdf item {i}: GLSL {} vs Rust {}",
                 out[3 * i + 1].w,
                 s.pdf
             );
-            assert_close3("bsdf_sample weight", i, out[3 * i + 2].truncate(), s.weight, m);
+            assert_vec3_close(
+                format_args!("bsdf_sample weight item {i} for {m:?}"),
+                out[3 * i + 2].truncate(),
+                s.weight,
+                TOL,
+            );
         }
     }
     eprintln!(

@@ -74,6 +74,13 @@ pub fn close(a: f32, b: f32, tol: f32) -> bool {
     (a - b).abs() <= tol * 1f32.max(a.abs()).max(b.abs())
 }
 
+/// Component-wise `close` of a GLSL result and its Rust twin; `what` names the case on failure.
+pub fn assert_vec3_close(what: impl std::fmt::Display, gpu: glam::Vec3, cpu: glam::Vec3, tol: f32) {
+    for k in 0..3 {
+        assert!(close(gpu[k], cpu[k], tol), "{what}: GLSL {gpu} vs Rust {cpu}");
+    }
+}
+
 /// A small deterministic generator for test inputs (SplitMix64).
 pub struct TestRng(pub u64);
 

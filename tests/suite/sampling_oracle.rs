@@ -3,16 +3,10 @@
 use glam::{Vec2, Vec3, Vec4};
 use restir_pt::sampling::*;
 
-use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_oracle, TestRng};
 
 /// Transcendentals differ by a few ulps between llvmpipe and Rust's libm.
 const TOL: f32 = 2e-5;
-
-fn assert_vec_close(what: &str, i: usize, gpu: Vec3, cpu: Vec3, tol: f32) {
-    for k in 0..3 {
-        assert!(close(gpu[k], cpu[k], tol), "{what} item {i}: GLSL {gpu} vs Rust {cpu}");
-    }
-}
 
 #[test]
 fn sampling_glsl_matches_rust() {
@@ -38,9 +32,8 @@ fn sampling_glsl_matches_rust() {
         let o = &out[7 * i..7 * i + 7];
         let n_dir = p.truncate().normalize();
         let (t, b) = build_onb(n_dir);
-        assert_vec_close(
-            "sample_cosine_hemisphere",
-            i,
+        assert_vec3_close(
+            format_args!("sample_cosine_hemisphere item {i}"),
             o[0].truncate(),
             sample_cosine_hemisphere(Vec2::new(u.x, u.y)),
             TOL,
@@ -49,9 +42,8 @@ fn sampling_glsl_matches_rust() {
             close(o[0].w, pdf_cosine_hemisphere(u.z * 2.0 - 1.0), TOL),
             "pdf_cosine_hemisphere item {i}"
         );
-        assert_vec_close(
-            "sample_uniform_sphere",
-            i,
+        assert_vec3_close(
+            format_args!("sample_uniform_sphere item {i}"),
             o[1].truncate(),
             sample_uniform_sphere(Vec2::new(u.x, u.y)),
             TOL,
@@ -59,19 +51,28 @@ fn sampling_glsl_matches_rust() {
         assert!(close(o[1].w, power_heuristic(u.z, u.w), TOL), "power_heuristic item {i}");
         let tri = sample_triangle(Vec2::new(u.x, u.y));
         let disk = sample_concentric_disk(Vec2::new(u.z, u.w));
-        assert_vec_close("sample_triangle", i, Vec3::new(o[2].x, o[2].y, 0.0), tri.extend(0.0), TOL);
-        assert_vec_close("sample_concentric_disk", i, Vec3::new(o[2].z, o[2].w, 0.0), disk.extend(0.0), TOL);
+        assert_vec3_close(
+            format_args!("sample_triangle item {i}"),
+            Vec3::new(o[2].x, o[2].y, 0.0),
+            tri.extend(0.0),
+            TOL,
+        );
+        assert_vec3_close(
+            format_args!("sample_concentric_disk item {i}"),
+            Vec3::new(o[2].z, o[2].w, 0.0),
+            disk.extend(0.0),
+            TOL,
+        );
         let wo = Vec3::new(p.x, p.y, p.z.abs() + 1e-3).normalize();
-        assert_vec_close(
-            "sample_ggx_vndf",
-            i,
+        assert_vec3_close(
+            format_args!("sample_ggx_vndf item {i}"),
             o[3].truncate(),
             sample_ggx_vndf(wo, p.w, Vec2::new(u.x, u.y)),
             1e-4,
         );
-        assert_vec_close("build_onb t", i, o[4].truncate(), t, TOL);
-        assert_vec_close("build_onb b", i, o[5].truncate(), b, TOL);
-        assert_vec_close("to_local/to_world", i, o[6].truncate(), u.truncate(), TOL);
+        assert_vec3_close(format_args!("build_onb t item {i}"), o[4].truncate(), t, TOL);
+        assert_vec3_close(format_args!("build_onb b item {i}"), o[5].truncate(), b, TOL);
+        assert_vec3_close(format_args!("to_local/to_world item {i}"), o[6].truncate(), u.truncate(), TOL);
     }
     assert_clean(&ctx);
 }
