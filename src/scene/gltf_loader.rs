@@ -82,11 +82,24 @@ fn invalid_gltf(path: &Path, e: gltf::Error) -> anyhow::Error {
     problem(path, if e.starts_with("invalid glTF") { e } else { format!("invalid glTF: {e}") })
 }
 
-/// Parses and validates glTF or GLB. gltf-json's validation indexes a primitive's POSITION
-/// accessor before checking that it exists (a panic on crafted input, found by fuzzing), so those
-/// indices are checked here first.
+/// GLB files start with this magic, then a version and the total length (12 bytes).
+const GLB_MAGIC: &[u8; 4] = b"glTF";
+const GLB_HEADER_BYTES: usize = 12;
+
+/// Parses and validates glTF or GLB. Two inputs that make the gltf crate panic (found by
+/// fuzzing) are checked here first: a GLB header whose length is shorter than the header itself
+/// (an overflowing subtraction), and a primitive whose POSITION accessor does not exist (which
+/// gltf-json's validation indexes unchecked).
 fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
     use gltf::json::{mesh::Semantic, validation::Checked};
+    if bytes.starts_with(GLB_MAGIC) {
+        let declared = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+        match declared {
+            Some(length) if (GLB_HEADER_BYTES..=bytes.len()).contains(&length) => {}
+            Some(length) => bail!(problem(path, format!("truncated or corrupt GLB: the header declares {length} bytes, the file has {}", bytes.len()))),
+            None => bail!(problem(path, format!("truncated GLB: {} bytes, less than its 12-byte header", bytes.len()))),
+        }
+    }
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid_gltf(path, e))?;
     let root = unchecked.document.into_json();
     for (m, mesh) in root.meshes.iter().enumerate() {
