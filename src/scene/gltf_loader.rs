@@ -288,6 +288,7 @@ impl Loader<'_> {
                 ));
                 continue;
             }
+            self.check_accessor_types(mesh, &prim)?;
             let buffers = self.buffers;
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let positions: Vec<Vec3> = reader
@@ -346,6 +347,24 @@ impl Loader<'_> {
                     e2: e2.into(),
                     pad: 0,
                 });
+            }
+        }
+        Ok(())
+    }
+
+    /// The spec's accessor types for positions (float VEC3) and indices (unsigned SCALAR); the
+    /// gltf crate's readers assume them (an index accessor of floats hits `unreachable!`).
+    fn check_accessor_types(&self, mesh: &gltf::Mesh, prim: &gltf::Primitive) -> Result<()> {
+        use gltf::accessor::{DataType, Dimensions};
+        if let Some(p) = prim.get(&gltf::Semantic::Positions) {
+            if p.data_type() != DataType::F32 || p.dimensions() != Dimensions::Vec3 {
+                bail!(problem(self.path, format!("mesh {}: POSITION must be float VEC3, not {:?} {:?}", mesh.index(), p.data_type(), p.dimensions())));
+            }
+        }
+        if let Some(i) = prim.indices() {
+            let unsigned = matches!(i.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
+            if !unsigned || i.dimensions() != Dimensions::Scalar {
+                bail!(problem(self.path, format!("mesh {}: indices must be unsigned SCALAR, not {:?} {:?}", mesh.index(), i.data_type(), i.dimensions())));
             }
         }
         Ok(())
