@@ -21,6 +21,7 @@ struct LightSample {
     float dist;      // distance to the light point; +inf for the environment
     vec3 radiance;   // emitted radiance towards the shading point (0 from a back face)
     float pdf;       // solid-angle pdf including the selection probability; 0 if impossible
+    uint triangle;   // the emitter triangle sampled, NO_EMITTER for the environment
 };
 
 // Emitted radiance of a triangle towards direction `to_viewer` (front face only unless double-sided).
@@ -63,6 +64,7 @@ LightSample sample_light(vec3 p, vec3 u) {
     ls.dist = 0.0;
     ls.radiance = vec3(0.0);
     ls.pdf = 0.0;
+    ls.triangle = NO_EMITTER;
     float p_env = env_select_prob();
     if (SCENE_ENVIRONMENT != 0 && u.x < p_env) {
         ls.dir = sample_uniform_sphere(u.yz);
@@ -75,6 +77,7 @@ LightSample sample_light(vec3 p, vec3 u) {
     float u_select = (u.x - p_env) / (1.0 - p_env);
     Emitter e = emitters[alias_select(min(u_select, 0.99999994), emitter_count)];
     Triangle tri = triangles[e.triangle];
+    ls.triangle = e.triangle;
     vec2 b = sample_triangle(u.yz);
     vec3 q = tri.v0 + b.x * tri.e1 + b.y * tri.e2;
     vec3 to_light = q - p;

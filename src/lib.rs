@@ -14,4 +14,5 @@ pub mod render;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
+pub mod shift;
 pub mod vk;

@@ -12,6 +12,8 @@ pub struct LightSample {
     pub dist: f32,
     pub radiance: Vec3,
     pub pdf: f32,
+    /// The emitter triangle sampled, NO_EMITTER for the environment.
+    pub triangle: u32,
 }
 
 /// Vose's alias table over `weights` (all finite, non-negative, positive sum).
@@ -94,6 +96,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
         dist: 0.0,
         radiance: Vec3::ZERO,
         pdf: 0.0,
+        triangle: NO_EMITTER,
     };
     let p_env = scene.env_select_prob;
     if u.x < p_env {
@@ -102,6 +105,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
             dist: f32::INFINITY,
             radiance: scene.environment,
             pdf: environment_pdf(scene),
+            triangle: NO_EMITTER,
         };
     }
     if scene.emitters.is_empty() {
@@ -124,5 +128,6 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
         dist,
         radiance: emitted_radiance(scene, tri, -dir),
         pdf: emitter_pdf(scene, e.triangle, dir, dist),
+        triangle: e.triangle,
     }
 }

@@ -28,5 +28,5 @@ void main() {
     outputs[5u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d));
     outputs[5u * i + 2u] = vec4(ls.dir, ls.dist);
     outputs[5u * i + 3u] = vec4(ls.radiance, ls.pdf);
-    outputs[5u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), 0.0);
+    outputs[5u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), uintBitsToFloat(ls.triangle));
 }

@@ -79,7 +79,14 @@ pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> 
 fn invalid_gltf(path: &Path, e: gltf::Error) -> anyhow::Error {
     let e = e.to_string();
     // The gltf crate prefixes validation errors itself; JSON errors need the context.
-    problem(path, if e.starts_with("invalid glTF") { e } else { format!("invalid glTF: {e}") })
+    problem(
+        path,
+        if e.starts_with("invalid glTF") {
+            e
+        } else {
+            format!("invalid glTF: {e}")
+        },
+    )
 }
 
 /// GLB files start with this magic, then a version and the total length (12 bytes).
@@ -96,8 +103,17 @@ fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
         let declared = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
         match declared {
             Some(length) if (GLB_HEADER_BYTES..=bytes.len()).contains(&length) => {}
-            Some(length) => bail!(problem(path, format!("truncated or corrupt GLB: the header declares {length} bytes, the file has {}", bytes.len()))),
-            None => bail!(problem(path, format!("truncated GLB: {} bytes, less than its 12-byte header", bytes.len()))),
+            Some(length) => bail!(problem(
+                path,
+                format!(
+                    "truncated or corrupt GLB: the header declares {length} bytes, the file has {}",
+                    bytes.len()
+                )
+            )),
+            None => bail!(problem(
+                path,
+                format!("truncated GLB: {} bytes, less than its 12-byte header", bytes.len())
+            )),
         }
     }
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid_gltf(path, e))?;
@@ -106,13 +122,23 @@ fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
         for primitive in &mesh.primitives {
             if let Some(index) = primitive.attributes.get(&Checked::Valid(Semantic::Positions)) {
                 if index.value() >= root.accessors.len() {
-                    bail!(problem(path, format!("mesh {m}: POSITION names accessor {}, but there are {}", index.value(), root.accessors.len())));
+                    bail!(problem(
+                        path,
+                        format!(
+                            "mesh {m}: POSITION names accessor {}, but there are {}",
+                            index.value(),
+                            root.accessors.len()
+                        )
+                    ));
                 }
             }
         }
     }
     let document = gltf::Document::from_json(root).map_err(|e| invalid_gltf(path, e))?;
-    Ok(gltf::Gltf { document, blob: unchecked.blob })
+    Ok(gltf::Gltf {
+        document,
+        blob: unchecked.blob,
+    })
 }
 
 fn scene_environment(path: &Path, scene: &gltf::Scene) -> Result<Vec3> {
@@ -358,13 +384,29 @@ impl Loader<'_> {
         use gltf::accessor::{DataType, Dimensions};
         if let Some(p) = prim.get(&gltf::Semantic::Positions) {
             if p.data_type() != DataType::F32 || p.dimensions() != Dimensions::Vec3 {
-                bail!(problem(self.path, format!("mesh {}: POSITION must be float VEC3, not {:?} {:?}", mesh.index(), p.data_type(), p.dimensions())));
+                bail!(problem(
+                    self.path,
+                    format!(
+                        "mesh {}: POSITION must be float VEC3, not {:?} {:?}",
+                        mesh.index(),
+                        p.data_type(),
+                        p.dimensions()
+                    )
+                ));
             }
         }
         if let Some(i) = prim.indices() {
             let unsigned = matches!(i.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
             if !unsigned || i.dimensions() != Dimensions::Scalar {
-                bail!(problem(self.path, format!("mesh {}: indices must be unsigned SCALAR, not {:?} {:?}", mesh.index(), i.data_type(), i.dimensions())));
+                bail!(problem(
+                    self.path,
+                    format!(
+                        "mesh {}: indices must be unsigned SCALAR, not {:?} {:?}",
+                        mesh.index(),
+                        i.data_type(),
+                        i.dimensions()
+                    )
+                ));
             }
         }
         Ok(())

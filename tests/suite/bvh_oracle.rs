@@ -152,6 +152,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         );
         let dir = camera.ray_dir(px.x, px.y, settings.width, settings.height);
         assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
+        assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
     }
     assert!(
         hits > RAYS / 4,

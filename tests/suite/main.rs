@@ -14,3 +14,4 @@ mod sampling_oracle;
 mod sampling_statistics;
 mod scene_loader;
 mod scenes;
+mod shift;

@@ -1,0 +1,443 @@
+//! Shift mappings of ReSTIR PT in the primary-sample-space (PSS) measure: the Rust reference that
+//! glsl/shift.glsl is to mirror. A path is regenerated from its primary hit and its seed (the
+//! counter-based RNG of src/rng.rs), so random replay needs nothing else; reconnection and hybrid
+//! keep the base path's suffix from the reconnection vertex x_r on.
+//!
+//! Contribution f(X) of a path x0 (camera), x1 (primary hit), ..., xk: the product over the
+//! scattering vertices of f_s |cos| / p (p the solid-angle pdf that sampled the next vertex: the
+//! BSDF's, or the light's for an NEE end) times the emitted radiance at xk. Jacobians are
+//! |du_Y / du_X| of the random numbers: 1 for replay; for a reconnection at x_r from y_{r-1}
+//! instead of x_{r-1}
+//!   |T'| = [p(y_{r-1} -> x_r) |cos_r(y)| / |y_{r-1} - x_r|^2] / [p(x_{r-1} -> x_r) |cos_r(x)| / |x_{r-1} - x_r|^2]
+//!          * p(x_r -> x_{r+1} | y_{r-1}) / p(x_r -> x_{r+1} | x_{r-1}),
+//! where the first ratio is 1 for a light point chosen by NEE (area sampling ignores the shading
+//! point), only the pdf ratio remains for an escaped direction, and the second ratio is 1 when
+//! x_r is the end or x_{r+1} is the NEE end.
+
+use glam::Vec3;
+
+use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::bvh::{offset_ray_origin, trace_closest, trace_occluded, NO_HIT};
+use crate::gpu_types::NO_EMITTER;
+use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
+use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
+use crate::scene::Scene;
+
+/// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
+pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
+/// The distance threshold as a fraction of the scene's smallest bounding-box extent.
+pub const DEFAULT_DISTANCE_FRACTION: f32 = 0.03;
+/// Shadow rays stop this fraction short of their target, as in the path tracer.
+const SHADOW_EPSILON: f32 = 1e-4;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShiftParams {
+    pub roughness_threshold: f32,
+    pub distance_threshold: f32,
+}
+
+impl ShiftParams {
+    pub fn for_scene(scene: &Scene) -> ShiftParams {
+        let extent = (scene.bounds.1 - scene.bounds.0).max(Vec3::splat(1e-6));
+        ShiftParams {
+            roughness_threshold: DEFAULT_ROUGHNESS_THRESHOLD,
+            distance_threshold: DEFAULT_DISTANCE_FRACTION * extent.min_element(),
+        }
+    }
+}
+
+/// A path vertex: a surface point, or (triangle == NO_HIT) a direction to the environment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Vertex {
+    pub pos: Vec3,
+    pub normal: Vec3,
+    pub triangle: u32,
+}
+
+impl Vertex {
+    pub fn is_escaped(&self) -> bool {
+        self.triangle == NO_HIT
+    }
+
+    pub fn on_surface(scene: &Scene, triangle: u32, pos: Vec3) -> Vertex {
+        let normal = scene.triangles[triangle as usize].normal_area2().normalize();
+        Vertex { pos, normal, triangle }
+    }
+
+    fn escaped(dir: Vec3) -> Vertex {
+        Vertex {
+            pos: dir,
+            normal: Vec3::ZERO,
+            triangle: NO_HIT,
+        }
+    }
+}
+
+/// A path x1..xk from a camera position, with what regenerating it needs (seed, end type) and
+/// what sampling it produced (lobes, pdfs, per-vertex weights).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Path {
+    pub seed: u32,
+    pub camera: Vec3,
+    /// x1..xk.
+    pub vertices: Vec<Vertex>,
+    /// True if xk is a light sample taken by NEE at x_{k-1}; false if BSDF sampling hit it.
+    pub nee_end: bool,
+    /// The lobe sampled at x1..x_{k-1} (LOBE_NONE where NEE chose the next vertex).
+    pub lobes: Vec<u32>,
+    /// f_s |cos| / p at x1..x_{k-1}.
+    pub weights: Vec<Vec3>,
+    /// f(X); zero if the end emits nothing towards x_{k-1}.
+    pub contribution: Vec3,
+}
+
+impl Path {
+    pub fn length(&self) -> usize {
+        self.vertices.len()
+    }
+}
+
+/// The result of a shift: a valid path with its Jacobian, or an explicit failure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShiftResult {
+    pub valid: bool,
+    pub path: Option<Path>,
+    pub jacobian: f32,
+    pub contribution: Vec3,
+}
+
+impl ShiftResult {
+    fn failed() -> ShiftResult {
+        ShiftResult {
+            valid: false,
+            path: None,
+            jacobian: 0.0,
+            contribution: Vec3::ZERO,
+        }
+    }
+
+    fn ok(path: Path, jacobian: f32) -> ShiftResult {
+        // A non-finite or non-positive Jacobian counts as a failed shift, never as a value.
+        if !(jacobian.is_finite() && jacobian > 0.0) || !path.contribution.is_finite() {
+            return ShiftResult::failed();
+        }
+        ShiftResult {
+            valid: true,
+            contribution: path.contribution,
+            jacobian,
+            path: Some(path),
+        }
+    }
+}
+
+/// Whether a vertex may be a reconnection endpoint: every lobe of its material is rough
+/// (diffuse, or GGX at least as rough as the threshold). Escaped directions count as rough.
+pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool {
+    if v.is_escaped() {
+        return true;
+    }
+    let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
+    let (_, w_c, w_t) = lobe_weights(m);
+    let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
+    (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || rough_ggx)
+}
+
+/// The reconnection test for the pair (prev, cur): both rough and far enough apart.
+pub fn is_reconnectable(scene: &Scene, prev: &Vertex, cur: &Vertex, params: &ShiftParams) -> bool {
+    let far = cur.is_escaped() || prev.pos.distance(cur.pos) >= params.distance_threshold;
+    !prev.is_escaped() && far && vertex_is_rough(scene, prev, params) && vertex_is_rough(scene, cur, params)
+}
+
+/// The first index r >= 2 (1-based, x_r = vertices[r - 1]) whose pair (x_{r-1}, x_r) passes the
+/// reconnection test, if any.
+pub fn reconnection_index(scene: &Scene, path: &Path, params: &ShiftParams) -> Option<usize> {
+    (2..=path.length()).find(|&r| is_reconnectable(scene, &path.vertices[r - 2], &path.vertices[r - 1], params))
+}
+
+fn material_of(scene: &Scene, v: &Vertex) -> crate::gpu_types::Material {
+    scene.materials[scene.triangles[v.triangle as usize].material as usize]
+}
+
+/// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
+fn direction(from: &Vertex, to: &Vertex) -> (Vec3, f32) {
+    if to.is_escaped() {
+        (to.pos, f32::INFINITY)
+    } else {
+        let d = to.pos - from.pos;
+        let len = d.length();
+        (d / len, len)
+    }
+}
+
+/// Whether the segment between two vertices is free. Both ends are offset off their surfaces
+/// and the ray runs between the offset points: at grazing angles an offset at one end only moves
+/// the far hit by far more than any epsilon along the ray.
+fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
+    let (dir, _) = direction(from, to);
+    let facing = |n: Vec3, d: Vec3| if d.dot(n) > 0.0 { n } else { -n };
+    let origin = offset_ray_origin(from.pos, facing(from.normal, dir));
+    if to.is_escaped() {
+        return !trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
+    }
+    let target = offset_ray_origin(to.pos, facing(to.normal, -dir));
+    !trace_occluded(&scene.nodes, &scene.triangles, origin, target - origin, 1.0 - SHADOW_EPSILON)
+}
+
+/// Radiance emitted by the end vertex `end` towards `from`.
+fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
+    if end.is_escaped() {
+        return scene.environment;
+    }
+    let tri = &scene.triangles[end.triangle as usize];
+    if tri.emitter == NO_EMITTER {
+        return Vec3::ZERO;
+    }
+    emitted_radiance(scene, tri, (from.pos - end.pos).normalize())
+}
+
+/// Solid-angle pdf that NEE at `from` picks `end`.
+fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
+    let (dir, dist) = direction(from, end);
+    if end.is_escaped() {
+        environment_pdf(scene)
+    } else {
+        emitter_pdf(scene, end.triangle, dir, dist)
+    }
+}
+
+/// Regenerates the path of `length` vertices from the primary hit `x1` seen from `camera`, with
+/// the random numbers of `seed`: BSDF sampling at x1..x_{k-2} and, at x_{k-1}, NEE when
+/// `nee_end`, else BSDF sampling. `None` if the path ends early (a miss, a failed sample, an
+/// occluded light sample) or its end emits nothing towards it.
+pub fn generate_path(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: usize, nee_end: bool) -> Option<Path> {
+    let mut path = trace_vertices(scene, camera, x1, seed, length, nee_end)?;
+    let k = path.length();
+    let emitted = if k >= 2 {
+        end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1])
+    } else {
+        Vec3::ZERO
+    };
+    path.contribution = path.weights.iter().fold(emitted, |acc, &w| acc * w);
+    (path.contribution.max_element() > 0.0).then_some(path)
+}
+
+/// The vertices, lobes and weights of `generate_path`, without the emission at the end.
+fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: usize, nee_end: bool) -> Option<Path> {
+    let mut path = Path {
+        seed,
+        camera,
+        vertices: vec![x1],
+        nee_end,
+        lobes: Vec::new(),
+        weights: Vec::new(),
+        contribution: Vec3::ZERO,
+    };
+    let mut prev_pos = camera;
+    while path.length() < length {
+        let i = path.length();
+        let x = *path.vertices.last().expect("x1 is present");
+        if x.is_escaped() {
+            return None;
+        }
+        let wo = (prev_pos - x.pos).normalize();
+        let m = material_of(scene, &x);
+        let (next, lobe, weight) = if i + 1 == length && nee_end {
+            let ls = sample_light(scene, x.pos, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate());
+            if !(ls.pdf > 0.0) {
+                return None;
+            }
+            let end = if ls.triangle == NO_EMITTER {
+                Vertex::escaped(ls.dir)
+            } else {
+                Vertex::on_surface(scene, ls.triangle, x.pos + ls.dir * ls.dist)
+            };
+            if !visible(scene, &x, &end) {
+                return None;
+            }
+            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, wo, ls.dir).0 / ls.pdf)
+        } else {
+            let s = bsdf_sample(&m, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
+            if s.lobe == LOBE_NONE {
+                return None;
+            }
+            let side = if s.wi.dot(x.normal) > 0.0 { x.normal } else { -x.normal };
+            let hit = trace_closest(&scene.nodes, &scene.triangles, offset_ray_origin(x.pos, side), s.wi, 1e30);
+            let next = if hit.triangle == NO_HIT {
+                Vertex::escaped(s.wi)
+            } else {
+                hit_vertex(scene, hit)
+            };
+            (next, s.lobe, s.weight)
+        };
+        path.lobes.push(lobe);
+        path.weights.push(weight);
+        path.vertices.push(next);
+        prev_pos = x.pos;
+    }
+    Some(path)
+}
+
+fn hit_vertex(scene: &Scene, hit: crate::bvh::Hit) -> Vertex {
+    let t = &scene.triangles[hit.triangle as usize];
+    Vertex::on_surface(
+        scene,
+        hit.triangle,
+        Vec3::from(t.v0) + hit.bary.x * Vec3::from(t.e1) + hit.bary.y * Vec3::from(t.e2),
+    )
+}
+
+/// Random replay: regenerate the base path's random numbers from the target's primary hit.
+/// Valid only with the same length, end type and lobes at every vertex; Jacobian 1.
+pub fn shift_random_replay(scene: &Scene, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
+    match generate_path(scene, camera, y1, base.seed, base.length(), base.nee_end) {
+        Some(y) if y.lobes == base.lobes => ShiftResult::ok(y, 1.0),
+        _ => ShiftResult::failed(),
+    }
+}
+
+/// The inverse of random replay is random replay back to the base's primary hit.
+pub fn inverse_random_replay(scene: &Scene, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+    shift_random_replay(scene, shifted, camera, x1)
+}
+
+/// Hybrid shift: replay up to x_{r-1} (r the base's reconnection index), then reconnect to x_r and
+/// keep the base's suffix. Without a reconnection index it is random replay; it fails where the
+/// replayed prefix would reconnect earlier than r, so that its inverse is defined.
+pub fn shift_hybrid(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
+    match reconnection_index(scene, base, params) {
+        None => {
+            let replay = shift_random_replay(scene, base, camera, y1);
+            match &replay.path {
+                Some(y) if reconnection_index(scene, y, params).is_none() => replay,
+                _ => ShiftResult::failed(),
+            }
+        }
+        Some(r) => reconnect_at(scene, params, base, camera, y1, r),
+    }
+}
+
+/// The inverse of the hybrid shift is the hybrid shift back: the shifted path has the same
+/// reconnection index, the same seed and the same suffix.
+pub fn inverse_hybrid(scene: &Scene, params: &ShiftParams, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+    shift_hybrid(scene, params, shifted, camera, x1)
+}
+
+/// Reconnection shift: y0, y1 of the target, then x2..xk of the base. Valid only if the base
+/// reconnects at r = 2 (x1 and x2 rough, far enough apart) and so does the shifted path.
+pub fn shift_reconnection(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
+    match reconnection_index(scene, base, params) {
+        Some(2) => reconnect_at(scene, params, base, camera, y1, 2),
+        _ => ShiftResult::failed(),
+    }
+}
+
+/// The inverse of the reconnection shift is the reconnection shift back to x1.
+pub fn inverse_reconnection(scene: &Scene, params: &ShiftParams, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+    shift_reconnection(scene, params, shifted, camera, x1)
+}
+
+/// Replays y1..y_{r-1} and reconnects y_{r-1} to the base's x_r (1-based indices).
+fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex, r: usize) -> ShiftResult {
+    let k = base.length();
+    // The replayed prefix y1..y_{r-1}: BSDF sampling only, whatever the base's end type.
+    let Some(prefix) = trace_vertices(scene, camera, y1, base.seed, r - 1, false) else {
+        return ShiftResult::failed();
+    };
+    if prefix.lobes[..] != base.lobes[..r - 2] {
+        return ShiftResult::failed();
+    }
+    // Invertibility: the shifted path must first become reconnectable at r, not earlier.
+    if (2..r).any(|i| is_reconnectable(scene, &prefix.vertices[i - 2], &prefix.vertices[i - 1], params)) {
+        return ShiftResult::failed();
+    }
+    let y_prev = prefix.vertices[r - 2];
+    let x_prev = base.vertices[r - 2];
+    let x_r = base.vertices[r - 1];
+    if !is_reconnectable(scene, &y_prev, &x_r, params) || !visible(scene, &y_prev, &x_r) {
+        return ShiftResult::failed();
+    }
+    let y_before = if r >= 3 { prefix.vertices[r - 3].pos } else { camera };
+    let x_before = if r >= 3 { base.vertices[r - 3].pos } else { base.camera };
+    let (dir_y, dist_y) = direction(&y_prev, &x_r);
+    let (dir_x, dist_x) = direction(&x_prev, &x_r);
+    let ends_at_r = r == k;
+    let nee_at_r = ends_at_r && base.nee_end;
+
+    // The vertex y_{r-1}: f_s |cos| over the pdf that would have chosen x_r from it.
+    let m_prev_y = material_of(scene, &y_prev);
+    let (f_prev_y, bsdf_pdf_y) = bsdf_eval_pdf(&m_prev_y, y_prev.normal, (y_before - y_prev.pos).normalize(), dir_y);
+    let (_, bsdf_pdf_x) = bsdf_eval_pdf(
+        &material_of(scene, &x_prev),
+        x_prev.normal,
+        (x_before - x_prev.pos).normalize(),
+        dir_x,
+    );
+    let (p_y, p_x) = if nee_at_r {
+        (light_pdf(scene, &y_prev, &x_r), light_pdf(scene, &x_prev, &x_r))
+    } else {
+        (bsdf_pdf_y, bsdf_pdf_x)
+    };
+    if !(p_y > 0.0 && p_x > 0.0) || f_prev_y.max_element() <= 0.0 {
+        return ShiftResult::failed();
+    }
+    let mut jacobian = if nee_at_r {
+        1.0
+    } else if x_r.is_escaped() {
+        p_y / p_x
+    } else {
+        let geometry = |dir: Vec3, dist: f32| x_r.normal.dot(dir).abs() / (dist * dist);
+        (p_y * geometry(dir_y, dist_y)) / (p_x * geometry(dir_x, dist_x))
+    };
+    let mut weights: Vec<Vec3> = prefix.weights.clone();
+    weights.push(f_prev_y / p_y);
+    let mut lobes = prefix.lobes.clone();
+    lobes.push(base.lobes[r - 2]);
+    if !ends_at_r {
+        // The vertex x_r scatters towards x_{r+1} with a new incoming direction.
+        let x_next = base.vertices[r];
+        let (dir_next, _) = direction(&x_r, &x_next);
+        let m_r = material_of(scene, &x_r);
+        let (f_r, pdf_r_y) = bsdf_eval_pdf(&m_r, x_r.normal, -dir_y, dir_next);
+        let (_, pdf_r_x) = bsdf_eval_pdf(&m_r, x_r.normal, -dir_x, dir_next);
+        let next_is_nee = r + 1 == k && base.nee_end;
+        let (q_y, q_x) = if next_is_nee {
+            (light_pdf(scene, &x_r, &x_next), light_pdf(scene, &x_r, &x_next))
+        } else {
+            (pdf_r_y, pdf_r_x)
+        };
+        if !(q_y > 0.0 && q_x > 0.0) || f_r.max_element() <= 0.0 || base.lobes[r - 1] & LOBE_DELTA != 0 {
+            return ShiftResult::failed();
+        }
+        if !next_is_nee {
+            jacobian *= q_y / q_x;
+        }
+        weights.push(f_r / q_y);
+        weights.extend_from_slice(&base.weights[r..]);
+        lobes.extend_from_slice(&base.lobes[r - 1..]);
+    }
+    let mut vertices = prefix.vertices.clone();
+    vertices.extend_from_slice(&base.vertices[r - 1..]);
+    let emitted = end_emission(scene, &vertices[k - 2], &vertices[k - 1]);
+    let contribution = weights.iter().fold(emitted, |acc, &w| acc * w);
+    if contribution.max_element() <= 0.0 {
+        return ShiftResult::failed();
+    }
+    let path = Path {
+        seed: base.seed,
+        camera,
+        vertices,
+        nee_end: base.nee_end,
+        lobes,
+        weights,
+        contribution,
+    };
+    ShiftResult::ok(path, jacobian)
+}
+
+/// The primary hit through image point (px, py) of `camera_index`, if any.
+pub fn primary_hit(scene: &Scene, camera_index: usize, px: f32, py: f32, width: u32, height: u32) -> Option<Vertex> {
+    let cam = &scene.cameras[camera_index];
+    let dir = cam.ray_dir(px, py, width, height);
+    let hit = trace_closest(&scene.nodes, &scene.triangles, cam.position, dir, 1e30);
+    (hit.triangle != NO_HIT).then(|| hit_vertex(scene, hit))
+}

@@ -1,0 +1,217 @@
+//! The shift mappings' Rust reference (src/shift.rs) on the bundled scenes: round trips,
+//! reciprocal Jacobians, finite-difference Jacobians, injectivity and clean failure.
+//! `cargo test --release shift` runs them all.
+
+use std::collections::HashSet;
+
+use glam::Vec3;
+use restir_pt::scene::{load_scene, Scene};
+use restir_pt::shift::*;
+
+use crate::common::{repo_path, TestRng};
+
+const IMAGE: u32 = 64;
+const RADIUS: f32 = 20.0;
+const BASE_PATHS: usize = 10_000;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    Reconnection,
+    RandomReplay,
+    Hybrid,
+}
+
+fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
+    match kind {
+        Kind::Reconnection => shift_reconnection(scene, params, base, camera, y1),
+        Kind::RandomReplay => shift_random_replay(scene, base, camera, y1),
+        Kind::Hybrid => shift_hybrid(scene, params, base, camera, y1),
+    }
+}
+
+fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+    match kind {
+        Kind::Reconnection => inverse_reconnection(scene, params, shifted, camera, x1),
+        Kind::RandomReplay => inverse_random_replay(scene, shifted, camera, x1),
+        Kind::Hybrid => inverse_hybrid(scene, params, shifted, camera, x1),
+    }
+}
+
+/// A base path in a random pixel of camera 0 and the primary hit of a neighbour within RADIUS.
+struct Case {
+    base: Path,
+    y1: Vertex,
+}
+
+fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
+    let mut r = TestRng(seed);
+    let mut out = Vec::with_capacity(count);
+    let mut attempts = 0;
+    while out.len() < count && attempts < 40 * count {
+        attempts += 1;
+        let (px, py) = (r.uniform() * IMAGE as f32, r.uniform() * IMAGE as f32);
+        let (qx, qy) = (
+            (px + (2.0 * r.uniform() - 1.0) * RADIUS).clamp(0.0, IMAGE as f32 - 0.01),
+            (py + (2.0 * r.uniform() - 1.0) * RADIUS).clamp(0.0, IMAGE as f32 - 0.01),
+        );
+        let (Some(x1), Some(y1)) = (
+            primary_hit(scene, 0, px, py, IMAGE, IMAGE),
+            primary_hit(scene, 0, qx, qy, IMAGE, IMAGE),
+        ) else {
+            continue;
+        };
+        let length = 2 + (r.uniform() * 5.0) as usize;
+        let nee_end = r.uniform() < 0.5;
+        if let Some(base) = generate_path(scene, scene.cameras[0].position, x1, r.next_u64() as u32, length, nee_end) {
+            out.push(Case { base, y1 });
+        }
+    }
+    // Scenes lit through a slit (veach-door) yield few paths that reach the light.
+    assert!(out.len() >= count / 10, "only {} of {count} base paths", out.len());
+    out
+}
+
+#[derive(Default, Debug)]
+struct Stats {
+    valid: usize,
+    failed: usize,
+}
+
+/// Shifts every case and checks, for every valid shift: finite positive Jacobian and finite
+/// contribution; the inverse is valid and returns the base path (vertices within 1e-4 of the
+/// scene's extent); the Jacobians are reciprocal within 1e-3. Failed shifts carry no value.
+fn check_round_trips(name: &str, kind: Kind) -> Stats {
+    let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    let params = ShiftParams::for_scene(&scene);
+    let camera = scene.cameras[0].position;
+    let tol = 1e-4 * scene.extent();
+    let mut stats = Stats::default();
+    let cases = cases(&scene, 1234, BASE_PATHS);
+    for (i, case) in cases.iter().enumerate() {
+        let y = shift(kind, &scene, &params, &case.base, camera, case.y1);
+        if !y.valid {
+            assert!(
+                y.jacobian == 0.0 && y.contribution == Vec3::ZERO && y.path.is_none(),
+                "{name} {kind:?} case {i}: a failed shift carries a value"
+            );
+            stats.failed += 1;
+            continue;
+        }
+        stats.valid += 1;
+        let shifted = y.path.as_ref().unwrap();
+        assert!(
+            y.jacobian.is_finite() && y.jacobian > 0.0 && y.contribution.is_finite(),
+            "{name} {kind:?} case {i}: {y:?}"
+        );
+        let back = inverse(kind, &scene, &params, shifted, camera, case.base.vertices[0]);
+        assert!(back.valid, "{name} {kind:?} case {i}: the inverse shift failed on a shifted path");
+        let back_path = back.path.unwrap();
+        assert_eq!(back_path.length(), case.base.length(), "{name} {kind:?} case {i}: length");
+        for (a, b) in back_path.vertices.iter().zip(&case.base.vertices) {
+            assert!(
+                a.pos.distance(b.pos) <= tol,
+                "{name} {kind:?} case {i}: round trip moved a vertex {} -> {}",
+                b.pos,
+                a.pos
+            );
+        }
+        let product = y.jacobian * back.jacobian;
+        assert!((product - 1.0).abs() <= 1e-3, "{name} {kind:?} case {i}: |T'| |T^-1'| = {product}");
+    }
+    eprintln!("{name} {kind:?}: {} valid, {} failed of {}", stats.valid, stats.failed, cases.len());
+    stats
+}
+
+fn round_trip_all_scenes(kind: Kind) {
+    for name in [
+        "cornell",
+        "cornell-glossy",
+        "glass",
+        "near-field",
+        "mirror",
+        "veach-door",
+        "env-ground",
+    ] {
+        let stats = check_round_trips(name, kind);
+        // Every shift must work somewhere in the diffuse Cornell box.
+        if name == "cornell" {
+            assert!(
+                stats.valid > BASE_PATHS / 10,
+                "{kind:?} is almost never valid in the Cornell box: {stats:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn shift_reconnection_round_trip_and_jacobian_reciprocal() {
+    round_trip_all_scenes(Kind::Reconnection);
+}
+
+#[test]
+fn shift_random_replay_round_trip_and_jacobian_reciprocal() {
+    round_trip_all_scenes(Kind::RandomReplay);
+}
+
+#[test]
+fn shift_hybrid_round_trip_and_jacobian_reciprocal() {
+    round_trip_all_scenes(Kind::Hybrid);
+}
+
+/// Within a batch shifted into one target pixel, distinct base paths give distinct shifted paths.
+fn check_injective(kind: Kind) {
+    for name in ["cornell", "cornell-glossy", "near-field"] {
+        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+        let params = ShiftParams::for_scene(&scene);
+        let camera = scene.cameras[0].position;
+        let y1 = primary_hit(&scene, 0, 31.5, 40.5, IMAGE, IMAGE).unwrap();
+        let mut inputs = HashSet::new();
+        let mut outputs = HashSet::new();
+        for case in cases(&scene, 99, 3000) {
+            let key = |p: &Path| p.vertices.iter().map(|v| v.pos.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            if !inputs.insert((key(&case.base), case.base.nee_end)) {
+                continue;
+            }
+            let y = shift(kind, &scene, &params, &case.base, camera, y1);
+            if let Some(p) = &y.path {
+                assert!(
+                    outputs.insert((key(p), p.nee_end)),
+                    "{name} {kind:?}: two distinct base paths shifted to the same path"
+                );
+            }
+        }
+        assert!(!outputs.is_empty() || kind != Kind::Hybrid, "{name} {kind:?}: nothing shifted");
+    }
+}
+
+#[test]
+fn shift_reconnection_injective() {
+    check_injective(Kind::Reconnection);
+}
+
+#[test]
+fn shift_random_replay_injective() {
+    check_injective(Kind::RandomReplay);
+}
+
+#[test]
+fn shift_hybrid_injective() {
+    check_injective(Kind::Hybrid);
+}
+
+/// Where reconnection cannot work it fails, cleanly: delta vertices (mirror, glass), too-short
+/// connections (near-field). Random replay fails where lengths or lobes differ.
+#[test]
+fn shift_fails_cleanly_where_it_must() {
+    for (name, kind, min_failure_share) in [
+        ("mirror", Kind::Reconnection, 0.05),
+        ("glass", Kind::Reconnection, 0.05),
+        ("near-field", Kind::Reconnection, 0.01),
+        ("cornell-glossy", Kind::RandomReplay, 0.05),
+        ("veach-door", Kind::RandomReplay, 0.2),
+    ] {
+        let stats = check_round_trips(name, kind);
+        let share = stats.failed as f64 / (stats.valid + stats.failed) as f64;
+        assert!(share >= min_failure_share, "{name} {kind:?}: only {:.1}% failed", 100.0 * share);
+    }
+}
