@@ -104,6 +104,8 @@ pub struct ShiftResult {
     pub path: Option<Path>,
     pub jacobian: f32,
     pub contribution: Vec3,
+    /// The reconnection's Jacobian terms, for shifts that reconnected.
+    pub reconnection: Option<ReconnectionTerms>,
 }
 
 impl ShiftResult {
@@ -113,6 +115,7 @@ impl ShiftResult {
             path: None,
             jacobian: 0.0,
             contribution: Vec3::ZERO,
+            reconnection: None,
         }
     }
 
@@ -126,6 +129,7 @@ impl ShiftResult {
             contribution: path.contribution,
             jacobian,
             path: Some(path),
+            reconnection: None,
         }
     }
 }
@@ -380,13 +384,20 @@ fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, 
     if !(p_y > 0.0 && p_x > 0.0) || f_prev_y.max_element() <= 0.0 {
         return ShiftResult::failed();
     }
-    let mut jacobian = if nee_at_r {
-        1.0
-    } else if x_r.is_escaped() {
-        p_y / p_x
-    } else {
-        let geometry = |dir: Vec3, dist: f32| x_r.normal.dot(dir).abs() / (dist * dist);
-        (p_y * geometry(dir_y, dist_y)) / (p_x * geometry(dir_x, dist_x))
+    let geometry = |dir: Vec3, dist: f32| {
+        if x_r.is_escaped() {
+            1.0
+        } else {
+            x_r.normal.dot(dir).abs() / (dist * dist)
+        }
+    };
+    let mut terms = ReconnectionTerms {
+        geometry_y: geometry(dir_y, dist_y),
+        geometry_x: geometry(dir_x, dist_x),
+        pdf_y: p_y,
+        pdf_x: p_x,
+        pdf_after_y: 1.0,
+        pdf_after_x: 1.0,
     };
     let mut weights: Vec<Vec3> = prefix.weights.clone();
     weights.push(f_prev_y / p_y);
@@ -409,7 +420,7 @@ fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, 
             return ShiftResult::failed();
         }
         if !next_is_nee {
-            jacobian *= q_y / q_x;
+            (terms.pdf_after_y, terms.pdf_after_x) = (q_y, q_x);
         }
         weights.push(f_r / q_y);
         weights.extend_from_slice(&base.weights[r..]);
@@ -431,7 +442,29 @@ fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, 
         weights,
         contribution,
     };
-    ShiftResult::ok(path, jacobian)
+    let mut result = ShiftResult::ok(path, terms.jacobian());
+    if result.valid {
+        result.reconnection = Some(terms);
+    }
+    result
+}
+
+/// The parts of a reconnection's Jacobian: the solid-angle-to-area factor |cos_r| / d^2 at x_r
+/// seen from each predecessor (1 for an escaped x_r) and the pdfs that chose x_r and x_{r+1}.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReconnectionTerms {
+    pub geometry_y: f32,
+    pub geometry_x: f32,
+    pub pdf_y: f32,
+    pub pdf_x: f32,
+    pub pdf_after_y: f32,
+    pub pdf_after_x: f32,
+}
+
+impl ReconnectionTerms {
+    pub fn jacobian(&self) -> f32 {
+        (self.pdf_y * self.geometry_y) / (self.pdf_x * self.geometry_x) * (self.pdf_after_y / self.pdf_after_x)
+    }
 }
 
 /// The primary hit through image point (px, py) of `camera_index`, if any.
