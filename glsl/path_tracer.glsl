@@ -12,12 +12,23 @@
 #include "rng.glsl"
 
 const float RAY_TMAX = 1e30;
-// Shadow rays stop this fraction short of the light point so that the emitter does not occlude itself.
+// Shadow rays stop this fraction short of their (offset) end point.
 const float SHADOW_EPSILON = 1e-4;
 const float RR_MAX_SURVIVAL = 0.95;
 const uint RR_START_DEPTH = 3u;
 
 float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+// Tests the segment from `origin` (already offset off the surface at x) to the light sample.
+// The light point is offset off the emitter too and the ray runs between the two offset points:
+// offsetting one end only moves a grazing far hit by more than any epsilon along the ray.
+bool shadow_ray_occluded(vec3 origin, vec3 x, LightSample ls) {
+    if (ls.triangle == NO_EMITTER) return trace_occluded(origin, ls.dir, RAY_TMAX);
+    Triangle light = triangles[ls.triangle];
+    vec3 nl = normalize(cross(light.e1, light.e2));
+    vec3 target = offset_ray_origin(x + ls.dir * ls.dist, dot(nl, ls.dir) < 0.0 ? nl : -nl);
+    return trace_occluded(origin, target - origin, 1.0 - SHADOW_EPSILON);
+}
 
 struct PathState {
     vec3 origin;
@@ -74,8 +85,7 @@ bool path_step(inout PathState s) {
         vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
             vec3 origin = offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng);
-            float tmax = isinf(ls.dist) ? RAY_TMAX : ls.dist * (1.0 - SHADOW_EPSILON);
-            if (!trace_occluded(origin, ls.dir, tmax)) {
+            if (!shadow_ray_occluded(origin, x, ls)) {
                 s.radiance += s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
             }
         }
