@@ -169,3 +169,24 @@ fn cli_frames_render_along_the_camera_path() {
         &["--frames 9", "8 camera(s)"],
     );
 }
+
+#[test]
+fn cli_device_by_index_is_chosen_and_printed() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let out = dir.join("dev.exr");
+    let (code, _, stderr) = restir_pt(&[
+        "render",
+        "--device",
+        "0",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.lines().any(|l| l.starts_with("device: ")), "{stderr}");
+}
