@@ -135,13 +135,10 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let mut report = None;
     let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
     for frame in 0..args.frames {
-        tracer.restart(
-            &scene,
-            &RenderSettings {
-                camera: args.camera + frame as usize,
-                ..settings.clone()
-            },
-        )?;
+        if frame > 0 {
+            let camera = args.camera + frame as usize;
+            tracer.restart(&scene, &RenderSettings { camera, ..settings.clone() })?;
+        }
         let bar = progress_bar(settings.spp);
         let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
         bar.finish_and_clear();
