@@ -10,6 +10,7 @@ pub mod gltf_writer;
 pub mod gpu_types;
 pub mod image_io;
 pub mod lights;
+pub mod path_record;
 pub mod render;
 pub mod rng;
 pub mod sampling;

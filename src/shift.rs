@@ -20,6 +20,7 @@ use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DE
 use crate::bvh::{offset_ray_origin, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::NO_EMITTER;
 use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
+use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
 use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::scene::Scene;
 
@@ -97,13 +98,16 @@ impl Path {
     }
 }
 
-/// The result of a shift: a valid path with its Jacobian, or an explicit failure.
+/// The result of a shift: the shifted path's record and Jacobian, or an explicit failure that
+/// carries no value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShiftResult {
     pub valid: bool,
-    pub path: Option<Path>,
+    pub record: PathRecord,
     pub jacobian: f32,
     pub contribution: Vec3,
+    /// The vertices the shift made: y1..y_{r-1} for a reconnection, the whole path for a replay.
+    pub vertices: Vec<Vertex>,
     /// The reconnection's Jacobian terms, for shifts that reconnected.
     pub reconnection: Option<ReconnectionTerms>,
 }
@@ -112,23 +116,26 @@ impl ShiftResult {
     fn failed() -> ShiftResult {
         ShiftResult {
             valid: false,
-            path: None,
+            record: PathRecord::default(),
             jacobian: 0.0,
             contribution: Vec3::ZERO,
+            vertices: vec![],
             reconnection: None,
         }
     }
 
-    fn ok(path: Path, jacobian: f32) -> ShiftResult {
+    fn ok(record: PathRecord, jacobian: f32, vertices: Vec<Vertex>) -> ShiftResult {
+        let contribution = record.contribution();
         // A non-finite or non-positive Jacobian counts as a failed shift, never as a value.
-        if !(jacobian.is_finite() && jacobian > 0.0) || !path.contribution.is_finite() {
+        if !(jacobian.is_finite() && jacobian > 0.0) || !contribution.is_finite() {
             return ShiftResult::failed();
         }
         ShiftResult {
             valid: true,
-            contribution: path.contribution,
+            record,
             jacobian,
-            path: Some(path),
+            contribution,
+            vertices,
             reconnection: None,
         }
     }
@@ -290,64 +297,208 @@ fn hit_vertex(scene: &Scene, hit: crate::bvh::Hit) -> Vertex {
     )
 }
 
-/// Random replay: regenerate the base path's random numbers from the target's primary hit.
-/// Valid only with the same length, end type and lobes at every vertex; Jacobian 1.
-pub fn shift_random_replay(scene: &Scene, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
-    match generate_path(scene, camera, y1, base.seed, base.length(), base.nee_end) {
-        Some(y) if y.lobes == base.lobes => ShiftResult::ok(y, 1.0),
+/// The record of `path`: its reconnection index and the base-side Jacobian terms there, the
+/// suffix's radiance and the contribution. `None` if the path is longer than a record holds, or
+/// if, evaluated from its vertices, its reconnection carries no light (grazing edges whose
+/// sampled direction and vertex-to-vertex direction fall on two sides of a surface).
+pub fn record_path(scene: &Scene, params: &ShiftParams, path: &Path) -> Option<PathRecord> {
+    let k = path.length();
+    if k > MAX_PATH_LENGTH {
+        return None;
+    }
+    let r = reconnection_index(scene, path, params);
+    let mut record = PathRecord {
+        seed: path.seed,
+        info: PathRecord::pack_info(k, r, path.nee_end),
+        lobes: PathRecord::pack_lobes(&path.lobes),
+        rc_triangle: NO_HIT,
+        rc_pdf: 1.0,
+        rc_geometry: 1.0,
+        suffix: [1.0; 3],
+        rc_pdf_after: 1.0,
+        rc_next_triangle: NO_HIT,
+        contribution: path.contribution.into(),
+        ..Default::default()
+    };
+    let Some(r) = r else { return Some(record) };
+    let x_r = path.vertices[r - 1];
+    record.rc_triangle = x_r.triangle;
+    record.rc_pos = x_r.pos.into();
+    if r < k {
+        let x_next = path.vertices[r];
+        record.rc_next = x_next.pos.into();
+        record.rc_next_triangle = x_next.triangle;
+        let emitted = end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1]);
+        record.suffix = path.weights[r..].iter().fold(emitted, |acc, &w| acc * w).into();
+    }
+    // The edges into and out of x_r are evaluated from the vertices, as every shift evaluates
+    // them: the sampled directions left from offset origins and differ slightly, which grazing
+    // angles magnify.
+    let x_before = if r >= 3 { path.vertices[r - 3].pos } else { path.camera };
+    let joined = join_at_reconnection(
+        scene,
+        &record,
+        &path.vertices[r - 2],
+        x_before,
+        &x_r,
+        path.weights[..r - 2].iter().product(),
+    )?;
+    Some(joined.record)
+}
+
+/// A path joined at x_r: the record with the terms from the given predecessor, and the Jacobian
+/// terms on that side.
+struct Joined {
+    record: PathRecord,
+    pdf_after: Option<f32>,
+}
+
+/// Joins the predecessor `prev` (reached from `before`, with prefix weight `prefix_weight` for
+/// the vertices before it) to the record's x_r: the pdf and geometry of the edge, the pdf out of
+/// x_r, and the contribution. `None` where the join carries no light or is impossible.
+fn join_at_reconnection(
+    scene: &Scene,
+    base: &PathRecord,
+    prev: &Vertex,
+    before: Vec3,
+    x_r: &Vertex,
+    prefix_weight: Vec3,
+) -> Option<Joined> {
+    let (k, r) = (base.length(), base.reconnection_index()?);
+    let link = reconnection_link(scene, prev, before, x_r, r == k && base.nee_end());
+    if !(link.pdf > 0.0) || link.f_cos.max_element() <= 0.0 {
+        return None;
+    }
+    let mut record = PathRecord {
+        rc_pdf: link.pdf,
+        rc_geometry: link.geometry,
+        rc_pdf_after: 1.0,
+        ..*base
+    };
+    let weight = prefix_weight * link.f_cos / link.pdf;
+    let mut pdf_after_x_r = None;
+    let contribution = if r == k {
+        weight * end_emission(scene, prev, x_r)
+    } else {
+        // x_r scatters towards x_{r+1} with this predecessor's incoming direction.
+        let x_next = record_vertex(scene, base.rc_next_triangle, base.rc_next);
+        let next_is_nee = r + 1 == k && base.nee_end();
+        let (f_r, q) = pdf_after(scene, x_r, link.dir, &x_next, next_is_nee);
+        if !(q > 0.0) || f_r.max_element() <= 0.0 || base.lobe(r) & LOBE_DELTA != 0 {
+            return None;
+        }
+        if !next_is_nee {
+            record.rc_pdf_after = q;
+            pdf_after_x_r = Some(q);
+        }
+        weight * f_r / q * Vec3::from(base.suffix)
+    };
+    if !(contribution.max_element() > 0.0) {
+        return None;
+    }
+    record.contribution = contribution.into();
+    Some(Joined {
+        record,
+        pdf_after: pdf_after_x_r,
+    })
+}
+
+/// The edge from a predecessor to x_r: its direction, f_s |cos| at the predecessor, the pdf that
+/// chose x_r from it and the geometry term |cos_r| / d^2 at x_r.
+struct Link {
+    dir: Vec3,
+    f_cos: Vec3,
+    pdf: f32,
+    geometry: f32,
+}
+
+fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, nee_at_r: bool) -> Link {
+    let (dir, dist) = direction(prev, x_r);
+    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, prev), prev.normal, (before - prev.pos).normalize(), dir);
+    let pdf = if nee_at_r { light_pdf(scene, prev, x_r) } else { bsdf_pdf };
+    let geometry = if x_r.is_escaped() {
+        1.0
+    } else {
+        x_r.normal.dot(dir).abs() / (dist * dist)
+    };
+    Link { dir, f_cos, pdf, geometry }
+}
+
+/// f_s |cos| at x_r arriving along `dir_in` and leaving to `next`, and the pdf that chose `next`
+/// from x_r (the light's when NEE chose it).
+fn pdf_after(scene: &Scene, x_r: &Vertex, dir_in: Vec3, next: &Vertex, next_is_nee: bool) -> (Vec3, f32) {
+    let (dir_next, _) = direction(x_r, next);
+    let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, -dir_in, dir_next);
+    (f_cos, if next_is_nee { light_pdf(scene, x_r, next) } else { pdf })
+}
+
+fn record_vertex(scene: &Scene, triangle: u32, pos: [f32; 3]) -> Vertex {
+    if triangle == NO_HIT {
+        Vertex::escaped(Vec3::from(pos))
+    } else {
+        Vertex::on_surface(scene, triangle, Vec3::from(pos))
+    }
+}
+
+/// Random replay: regenerate the record's random numbers from the target's primary hit. Valid
+/// only with the same length, end type and lobes at every vertex; Jacobian 1.
+pub fn shift_random_replay(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
+    let replayed = generate_path(scene, camera, y1, base.seed, base.length(), base.nee_end());
+    match replayed.as_ref().and_then(|y| Some((y, record_path(scene, params, y)?))) {
+        Some((y, record)) if record.lobes == base.lobes => ShiftResult::ok(record, 1.0, y.vertices.clone()),
         _ => ShiftResult::failed(),
     }
 }
 
 /// The inverse of random replay is random replay back to the base's primary hit.
-pub fn inverse_random_replay(scene: &Scene, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
-    shift_random_replay(scene, shifted, camera, x1)
+pub fn inverse_random_replay(scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
+    shift_random_replay(scene, params, shifted, camera, x1)
 }
 
-/// Hybrid shift: replay up to x_{r-1} (r the base's reconnection index), then reconnect to x_r and
-/// keep the base's suffix. Without a reconnection index it is random replay; it fails where the
+/// Hybrid shift: replay up to x_{r-1} (r the record's reconnection index), then reconnect to x_r
+/// and keep the suffix. Without a reconnection index it is random replay; it fails where the
 /// replayed prefix would reconnect earlier than r, so that its inverse is defined.
-pub fn shift_hybrid(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
-    match reconnection_index(scene, base, params) {
+pub fn shift_hybrid(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
+    match base.reconnection_index() {
         None => {
-            let replay = shift_random_replay(scene, base, camera, y1);
-            match &replay.path {
-                Some(y) if reconnection_index(scene, y, params).is_none() => replay,
-                _ => ShiftResult::failed(),
+            let replay = shift_random_replay(scene, params, base, camera, y1);
+            if replay.valid && replay.record.reconnection_index().is_none() {
+                replay
+            } else {
+                ShiftResult::failed()
             }
         }
         Some(r) => reconnect_at(scene, params, base, camera, y1, r),
     }
 }
 
-/// The inverse of the hybrid shift is the hybrid shift back: the shifted path has the same
-/// reconnection index, the same seed and the same suffix.
-pub fn inverse_hybrid(scene: &Scene, params: &ShiftParams, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+/// The inverse of the hybrid shift is the hybrid shift back: the shifted record has the same
+/// reconnection index, seed and suffix.
+pub fn inverse_hybrid(scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
     shift_hybrid(scene, params, shifted, camera, x1)
 }
 
 /// Reconnection shift: y0, y1 of the target, then x2..xk of the base. Valid only if the base
 /// reconnects at r = 2 (x1 and x2 rough, far enough apart) and so does the shifted path.
-pub fn shift_reconnection(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
-    match reconnection_index(scene, base, params) {
+pub fn shift_reconnection(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
+    match base.reconnection_index() {
         Some(2) => reconnect_at(scene, params, base, camera, y1, 2),
         _ => ShiftResult::failed(),
     }
 }
 
 /// The inverse of the reconnection shift is the reconnection shift back to x1.
-pub fn inverse_reconnection(scene: &Scene, params: &ShiftParams, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+pub fn inverse_reconnection(scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
     shift_reconnection(scene, params, shifted, camera, x1)
 }
 
-/// Replays y1..y_{r-1} and reconnects y_{r-1} to the base's x_r (1-based indices).
-fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex, r: usize) -> ShiftResult {
-    let k = base.length();
+/// Replays y1..y_{r-1} and reconnects y_{r-1} to the record's x_r (1-based indices).
+fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex, r: usize) -> ShiftResult {
     // The replayed prefix y1..y_{r-1}: BSDF sampling only, whatever the base's end type.
     let Some(prefix) = trace_vertices(scene, camera, y1, base.seed, r - 1, false) else {
         return ShiftResult::failed();
     };
-    if prefix.lobes[..] != base.lobes[..r - 2] {
+    if (1..r - 1).any(|i| prefix.lobes[i - 1] != base.lobe(i)) {
         return ShiftResult::failed();
     }
     // Invertibility: the shifted path must first become reconnectable at r, not earlier.
@@ -355,94 +506,27 @@ fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, 
         return ShiftResult::failed();
     }
     let y_prev = prefix.vertices[r - 2];
-    let x_prev = base.vertices[r - 2];
-    let x_r = base.vertices[r - 1];
+    let x_r = record_vertex(scene, base.rc_triangle, base.rc_pos);
     if !is_reconnectable(scene, &y_prev, &x_r, params) || !visible(scene, &y_prev, &x_r) {
         return ShiftResult::failed();
     }
     let y_before = if r >= 3 { prefix.vertices[r - 3].pos } else { camera };
-    let x_before = if r >= 3 { base.vertices[r - 3].pos } else { base.camera };
-    let (dir_y, dist_y) = direction(&y_prev, &x_r);
-    let (dir_x, dist_x) = direction(&x_prev, &x_r);
-    let ends_at_r = r == k;
-    let nee_at_r = ends_at_r && base.nee_end;
-
-    // The vertex y_{r-1}: f_s |cos| over the pdf that would have chosen x_r from it.
-    let m_prev_y = material_of(scene, &y_prev);
-    let (f_prev_y, bsdf_pdf_y) = bsdf_eval_pdf(&m_prev_y, y_prev.normal, (y_before - y_prev.pos).normalize(), dir_y);
-    let (_, bsdf_pdf_x) = bsdf_eval_pdf(
-        &material_of(scene, &x_prev),
-        x_prev.normal,
-        (x_before - x_prev.pos).normalize(),
-        dir_x,
-    );
-    let (p_y, p_x) = if nee_at_r {
-        (light_pdf(scene, &y_prev, &x_r), light_pdf(scene, &x_prev, &x_r))
-    } else {
-        (bsdf_pdf_y, bsdf_pdf_x)
+    let prefix_weight = prefix.weights.iter().product();
+    let Some(joined) = join_at_reconnection(scene, base, &y_prev, y_before, &x_r, prefix_weight) else {
+        return ShiftResult::failed();
     };
-    if !(p_y > 0.0 && p_x > 0.0) || f_prev_y.max_element() <= 0.0 {
+    if !(base.rc_pdf > 0.0 && base.rc_pdf_after > 0.0) {
         return ShiftResult::failed();
     }
-    let geometry = |dir: Vec3, dist: f32| {
-        if x_r.is_escaped() {
-            1.0
-        } else {
-            x_r.normal.dot(dir).abs() / (dist * dist)
-        }
+    let terms = ReconnectionTerms {
+        geometry_y: joined.record.rc_geometry,
+        geometry_x: base.rc_geometry,
+        pdf_y: joined.record.rc_pdf,
+        pdf_x: base.rc_pdf,
+        pdf_after_y: joined.pdf_after.unwrap_or(1.0),
+        pdf_after_x: joined.pdf_after.map_or(1.0, |_| base.rc_pdf_after),
     };
-    let mut terms = ReconnectionTerms {
-        geometry_y: geometry(dir_y, dist_y),
-        geometry_x: geometry(dir_x, dist_x),
-        pdf_y: p_y,
-        pdf_x: p_x,
-        pdf_after_y: 1.0,
-        pdf_after_x: 1.0,
-    };
-    let mut weights: Vec<Vec3> = prefix.weights.clone();
-    weights.push(f_prev_y / p_y);
-    let mut lobes = prefix.lobes.clone();
-    lobes.push(base.lobes[r - 2]);
-    if !ends_at_r {
-        // The vertex x_r scatters towards x_{r+1} with a new incoming direction.
-        let x_next = base.vertices[r];
-        let (dir_next, _) = direction(&x_r, &x_next);
-        let m_r = material_of(scene, &x_r);
-        let (f_r, pdf_r_y) = bsdf_eval_pdf(&m_r, x_r.normal, -dir_y, dir_next);
-        let (_, pdf_r_x) = bsdf_eval_pdf(&m_r, x_r.normal, -dir_x, dir_next);
-        let next_is_nee = r + 1 == k && base.nee_end;
-        let (q_y, q_x) = if next_is_nee {
-            (light_pdf(scene, &x_r, &x_next), light_pdf(scene, &x_r, &x_next))
-        } else {
-            (pdf_r_y, pdf_r_x)
-        };
-        if !(q_y > 0.0 && q_x > 0.0) || f_r.max_element() <= 0.0 || base.lobes[r - 1] & LOBE_DELTA != 0 {
-            return ShiftResult::failed();
-        }
-        if !next_is_nee {
-            (terms.pdf_after_y, terms.pdf_after_x) = (q_y, q_x);
-        }
-        weights.push(f_r / q_y);
-        weights.extend_from_slice(&base.weights[r..]);
-        lobes.extend_from_slice(&base.lobes[r - 1..]);
-    }
-    let mut vertices = prefix.vertices.clone();
-    vertices.extend_from_slice(&base.vertices[r - 1..]);
-    let emitted = end_emission(scene, &vertices[k - 2], &vertices[k - 1]);
-    let contribution = weights.iter().fold(emitted, |acc, &w| acc * w);
-    if contribution.max_element() <= 0.0 {
-        return ShiftResult::failed();
-    }
-    let path = Path {
-        seed: base.seed,
-        camera,
-        vertices,
-        nee_end: base.nee_end,
-        lobes,
-        weights,
-        contribution,
-    };
-    let mut result = ShiftResult::ok(path, terms.jacobian());
+    let mut result = ShiftResult::ok(joined.record, terms.jacobian(), prefix.vertices);
     if result.valid {
         result.reconnection = Some(terms);
     }

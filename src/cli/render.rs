@@ -137,7 +137,13 @@ pub fn render(args: RenderArgs) -> Result<()> {
     for frame in 0..args.frames {
         if frame > 0 {
             let camera = args.camera + frame as usize;
-            tracer.restart(&scene, &RenderSettings { camera, ..settings.clone() })?;
+            tracer.restart(
+                &scene,
+                &RenderSettings {
+                    camera,
+                    ..settings.clone()
+                },
+            )?;
         }
         let bar = progress_bar(settings.spp);
         let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;

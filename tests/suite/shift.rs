@@ -5,6 +5,7 @@
 use std::collections::HashSet;
 
 use glam::Vec3;
+use restir_pt::path_record::PathRecord;
 use restir_pt::scene::{load_scene, Scene};
 use restir_pt::shift::*;
 
@@ -21,18 +22,18 @@ enum Kind {
     Hybrid,
 }
 
-fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &Path, camera: Vec3, y1: Vertex) -> ShiftResult {
+fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
     match kind {
         Kind::Reconnection => shift_reconnection(scene, params, base, camera, y1),
-        Kind::RandomReplay => shift_random_replay(scene, base, camera, y1),
+        Kind::RandomReplay => shift_random_replay(scene, params, base, camera, y1),
         Kind::Hybrid => shift_hybrid(scene, params, base, camera, y1),
     }
 }
 
-fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &Path, camera: Vec3, x1: Vertex) -> ShiftResult {
+fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
     match kind {
         Kind::Reconnection => inverse_reconnection(scene, params, shifted, camera, x1),
-        Kind::RandomReplay => inverse_random_replay(scene, shifted, camera, x1),
+        Kind::RandomReplay => inverse_random_replay(scene, params, shifted, camera, x1),
         Kind::Hybrid => inverse_hybrid(scene, params, shifted, camera, x1),
     }
 }
@@ -40,10 +41,12 @@ fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &Path, came
 /// A base path in a random pixel of camera 0 and the primary hit of a neighbour within RADIUS.
 struct Case {
     base: Path,
+    record: PathRecord,
     y1: Vertex,
 }
 
 fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
+    let params = ShiftParams::for_scene(scene);
     let mut r = TestRng(seed);
     let mut out = Vec::with_capacity(count);
     let mut attempts = 0;
@@ -62,8 +65,12 @@ fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
         };
         let length = 2 + (r.uniform() * 5.0) as usize;
         let nee_end = r.uniform() < 0.5;
-        if let Some(base) = generate_path(scene, scene.cameras[0].position, x1, r.next_u64() as u32, length, nee_end) {
-            out.push(Case { base, y1 });
+        let base = generate_path(scene, scene.cameras[0].position, x1, r.next_u64() as u32, length, nee_end);
+        if let Some((base, record)) = base
+            .and_then(|b| Some((record_path(scene, &params, &b)?, b)))
+            .map(|(rec, b)| (b, rec))
+        {
+            out.push(Case { base, record, y1 });
         }
     }
     // Scenes lit through a slit (veach-door) yield few paths that reach the light.
@@ -77,9 +84,15 @@ struct Stats {
     failed: usize,
 }
 
+/// Relative closeness of record values that the round trip recomputes.
+fn near(a: f32, b: f32, tol: f32) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs()).max(1e-30)
+}
+
 /// Shifts every case and checks, for every valid shift: finite positive Jacobian and finite
-/// contribution; the inverse is valid and returns the base path (vertices within 1e-4 of the
-/// scene's extent); the Jacobians are reciprocal within 1e-3. Failed shifts carry no value.
+/// contribution; the inverse is valid and returns the base record (its cached terms within
+/// 1e-4, its contribution within 1e-3) and the base's vertices (within 1e-4 of the scene's
+/// extent); the Jacobians are reciprocal within 1e-3. Failed shifts carry no value.
 fn check_round_trips(name: &str, kind: Kind) -> Stats {
     let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
     let params = ShiftParams::for_scene(&scene);
@@ -88,31 +101,49 @@ fn check_round_trips(name: &str, kind: Kind) -> Stats {
     let mut stats = Stats::default();
     let cases = cases(&scene, 1234, BASE_PATHS);
     for (i, case) in cases.iter().enumerate() {
-        let y = shift(kind, &scene, &params, &case.base, camera, case.y1);
+        let y = shift(kind, &scene, &params, &case.record, camera, case.y1);
         if !y.valid {
             assert!(
-                y.jacobian == 0.0 && y.contribution == Vec3::ZERO && y.path.is_none(),
+                y.jacobian == 0.0 && y.contribution == Vec3::ZERO && y.vertices.is_empty(),
                 "{name} {kind:?} case {i}: a failed shift carries a value"
             );
             stats.failed += 1;
             continue;
         }
         stats.valid += 1;
-        let shifted = y.path.as_ref().unwrap();
         assert!(
             y.jacobian.is_finite() && y.jacobian > 0.0 && y.contribution.is_finite(),
             "{name} {kind:?} case {i}: {y:?}"
         );
-        let back = inverse(kind, &scene, &params, shifted, camera, case.base.vertices[0]);
+        let back = inverse(kind, &scene, &params, &y.record, camera, case.base.vertices[0]);
         assert!(back.valid, "{name} {kind:?} case {i}: the inverse shift failed on a shifted path");
-        let back_path = back.path.unwrap();
-        assert_eq!(back_path.length(), case.base.length(), "{name} {kind:?} case {i}: length");
-        for (a, b) in back_path.vertices.iter().zip(&case.base.vertices) {
+        let (a, b) = (&back.record, &case.record);
+        assert_eq!(
+            (a.seed, a.info, a.lobes, a.rc_triangle, a.rc_next_triangle, a.rc_pos, a.rc_next),
+            (b.seed, b.info, b.lobes, b.rc_triangle, b.rc_next_triangle, b.rc_pos, b.rc_next),
+            "{name} {kind:?} case {i}: record"
+        );
+        for (what, x, z) in [
+            ("rc_pdf", a.rc_pdf, b.rc_pdf),
+            ("rc_geometry", a.rc_geometry, b.rc_geometry),
+            ("rc_pdf_after", a.rc_pdf_after, b.rc_pdf_after),
+        ] {
+            assert!(near(x, z, 1e-4), "{name} {kind:?} case {i}: {what} {x} vs {z}");
+        }
+        for c in 0..3 {
             assert!(
-                a.pos.distance(b.pos) <= tol,
+                near(a.contribution[c], b.contribution[c], 1e-3),
+                "{name} {kind:?} case {i}: contribution {:?} vs {:?}",
+                a.contribution,
+                b.contribution
+            );
+        }
+        for (v, x) in back.vertices.iter().zip(&case.base.vertices) {
+            assert!(
+                v.pos.distance(x.pos) <= tol,
                 "{name} {kind:?} case {i}: round trip moved a vertex {} -> {}",
-                b.pos,
-                a.pos
+                x.pos,
+                v.pos
             );
         }
         let product = y.jacobian * back.jacobian;
@@ -168,14 +199,24 @@ fn check_injective(kind: Kind) {
         let mut inputs = HashSet::new();
         let mut outputs = HashSet::new();
         for case in cases(&scene, 99, 3000) {
-            let key = |p: &Path| p.vertices.iter().map(|v| v.pos.to_array().map(f32::to_bits)).collect::<Vec<_>>();
-            if !inputs.insert((key(&case.base), case.base.nee_end)) {
+            // A record and the vertices its shift rebuilt determine the whole path.
+            let key = |record: &PathRecord, vertices: &[Vertex]| {
+                let positions: Vec<[u32; 3]> = vertices.iter().map(|v| v.pos.to_array().map(f32::to_bits)).collect();
+                (
+                    record.seed,
+                    record.info,
+                    record.rc_pos.map(f32::to_bits),
+                    record.rc_next.map(f32::to_bits),
+                    positions,
+                )
+            };
+            if !inputs.insert(key(&case.record, &case.base.vertices)) {
                 continue;
             }
-            let y = shift(kind, &scene, &params, &case.base, camera, y1);
-            if let Some(p) = &y.path {
+            let y = shift(kind, &scene, &params, &case.record, camera, y1);
+            if y.valid {
                 assert!(
-                    outputs.insert((key(p), p.nee_end)),
+                    outputs.insert(key(&y.record, &y.vertices)),
                     "{name} {kind:?}: two distinct base paths shifted to the same path"
                 );
             }
@@ -236,8 +277,8 @@ fn check_jacobian_finite_difference(kind: Kind) {
         let h = 1e-5 * scene.extent() as f64;
         let mut checked = 0;
         for (i, case) in cases(&scene, 777, 2000).iter().enumerate() {
-            let y = shift(kind, &scene, &params, &case.base, camera, case.y1);
-            let (Some(terms), Some(shifted)) = (y.reconnection, &y.path) else {
+            let y = shift(kind, &scene, &params, &case.record, camera, case.y1);
+            let Some(terms) = y.reconnection else {
                 continue;
             };
             let r = reconnection_index(&scene, &case.base, &params).unwrap();
@@ -248,7 +289,7 @@ fn check_jacobian_finite_difference(kind: Kind) {
             let p = x_r.pos.as_dvec3();
             let (t1, t2) = restir_pt::sampling::build_onb(x_r.normal);
             let (a, b) = (p + h * t1.as_dvec3(), p + h * t2.as_dvec3());
-            let omega_y = solid_angle(shifted.vertices[r - 2].pos.as_dvec3(), p, a, b);
+            let omega_y = solid_angle(y.vertices[r - 2].pos.as_dvec3(), p, a, b);
             let omega_x = solid_angle(case.base.vertices[r - 2].pos.as_dvec3(), p, a, b);
             let finite_difference = omega_y / omega_x * (terms.pdf_y / terms.pdf_x) as f64 * (terms.pdf_after_y / terms.pdf_after_x) as f64;
             let analytic = y.jacobian as f64;
@@ -270,4 +311,26 @@ fn shift_reconnection_jacobian_finite_difference() {
 #[test]
 fn shift_hybrid_jacobian_finite_difference() {
     check_jacobian_finite_difference(Kind::Hybrid);
+}
+
+#[test]
+fn shift_path_record_is_80_bytes_and_packs_its_fields() {
+    assert_eq!(std::mem::size_of::<PathRecord>(), 80);
+    let info = PathRecord::pack_info(6, Some(3), true);
+    let lobes = PathRecord::pack_lobes(&[1, 2, 4 | 8, 16 | 4, 0]);
+    let record = PathRecord {
+        info,
+        lobes,
+        ..Default::default()
+    };
+    assert_eq!((record.length(), record.reconnection_index(), record.nee_end()), (6, Some(3), true));
+    assert_eq!((1..=5).map(|i| record.lobe(i)).collect::<Vec<_>>(), vec![1, 2, 12, 20, 0]);
+    assert_eq!(
+        PathRecord {
+            info: PathRecord::pack_info(2, None, false),
+            ..Default::default()
+        }
+        .reconnection_index(),
+        None
+    );
 }
