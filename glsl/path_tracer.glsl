@@ -17,7 +17,6 @@ const float SHADOW_EPSILON = 1e-4;
 const float RR_MAX_SURVIVAL = 0.95;
 const uint RR_START_DEPTH = 3u;
 
-float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
 // Tests the segment from `origin` (already offset off the surface at x) to the light sample.
 // The light point is offset off the emitter too and the ray runs between the two offset points:

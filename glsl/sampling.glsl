@@ -59,6 +59,8 @@ vec3 sample_ggx_vndf(vec3 wo, float alpha, vec2 u) {
     return normalize(vec3(alpha * h_std.x, alpha * h_std.y, max(h_std.z, 0.0)));
 }
 
+float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
 float power_heuristic(float a, float b) {
     float a2 = a * a;
     float b2 = b * b;

@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 use restir_pt::gpu_types::{BvhNode, Emitter, FrameParams, Material, Triangle};
+use restir_pt::path_record::PathRecord;
 use restir_pt::vk::compile_kernel;
 
 const OP_NAME: u32 = 5;
@@ -63,17 +64,20 @@ macro_rules! rust_fields {
     };
 }
 
-fn check_layout(kernel: &str, defines: &[(&str, &str)]) -> usize {
-    let spirv = compile_kernel(kernel, defines).expect("kernel compiles");
-    let r = reflect(&spirv);
-    let structs = [
+fn scene_structs() -> Vec<(&'static str, usize, Vec<(String, u32)>)> {
+    vec![
         rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, pad),
         rust_fields!(Triangle: v0, material, e1, emitter, e2, pad),
         rust_fields!(BvhNode: lo, skip, hi, leaf),
         rust_fields!(Emitter: triangle, select_pdf, alias_prob, alias),
         rust_fields!(FrameParams: cam_position, cam_right, cam_up, cam_forward, scene_env, width, height, sample_offset,
             samples_per_dispatch, max_depth, render_seed, flags, emitter_count),
-    ];
+    ]
+}
+
+fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<(&'static str, usize, Vec<(String, u32)>)>) -> usize {
+    let spirv = compile_kernel(kernel, defines).expect("kernel compiles");
+    let r = reflect(&spirv);
     let mut checked = 0;
     for (name, size, fields) in structs {
         // glslang also emits an undecorated copy of each struct for locals; only the copies with
@@ -103,7 +107,7 @@ fn check_layout(kernel: &str, defines: &[(&str, &str)]) -> usize {
 
 #[test]
 fn gpu_types_match_glsl_layout_in_storage_and_uniform_bindings() {
-    assert!(check_layout("pathtrace.comp", &[]) >= 5);
+    assert!(check_layout("pathtrace.comp", &[], scene_structs()) >= 5);
     let uniform = [
         ("SCENE_UNIFORM_BUFFERS", "1"),
         ("SCENE_TRIANGLE_COUNT", "4"),
@@ -111,5 +115,14 @@ fn gpu_types_match_glsl_layout_in_storage_and_uniform_bindings() {
         ("SCENE_MATERIAL_COUNT", "2"),
         ("SCENE_EMITTER_SLOTS", "1"),
     ];
-    assert!(check_layout("pathtrace.comp", &uniform) >= 5);
+    assert!(check_layout("pathtrace.comp", &uniform, scene_structs()) >= 5);
+}
+
+#[test]
+fn path_record_matches_glsl_layout() {
+    let record = vec![
+        rust_fields!(PathRecord: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry, suffix,
+        rc_pdf_after, contribution, rc_next_triangle),
+    ];
+    assert_eq!(check_layout("oracle/shift_oracle.comp", &[], record), 1);
 }

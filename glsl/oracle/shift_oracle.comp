@@ -1,0 +1,48 @@
+#version 460
+// Oracle kernel: one shift (or its inverse) per item on records the host made
+// (twin: src/shift.rs).
+#extension GL_GOOGLE_include_directive : require
+layout(local_size_x = 64) in;
+
+#include "../scene_bindings.glsl"
+#include "../shift.glsl"
+
+const uint KIND_RECONNECTION = 0u;
+const uint KIND_RANDOM_REPLAY = 1u;
+const uint KIND_HYBRID = 2u;
+
+// x: kind, y: roughness threshold, z: distance threshold (float bits), w: unused.
+layout(std430, set = 0, binding = 5) readonly buffer Params { uvec4 shift_params; };
+layout(std430, set = 0, binding = 6) readonly buffer Records { PathRecord records[]; };
+// Per item: target primary hit position (w: triangle bits), camera position.
+layout(std430, set = 0, binding = 7) readonly buffer Targets { vec4 targets[]; };
+// Per item, 13 vec4: (valid, jacobian, vertex count, 0), the record (5 vec4), the vertices (7 vec4).
+layout(std430, set = 0, binding = 8) writeonly buffer Outputs { vec4 outputs[]; };
+layout(push_constant) uniform Push { uint count; };
+
+const uint OUT_STRIDE = 13u;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= count) return;
+    ShiftParams params = ShiftParams(uintBitsToFloat(shift_params.y), uintBitsToFloat(shift_params.z));
+    vec4 target = targets[2u * i];
+    Vertex y1 = vertex_on_surface(floatBitsToUint(target.w), target.xyz);
+    vec3 camera = targets[2u * i + 1u].xyz;
+    PathRecord base = records[i];
+    ShiftResult s;
+    if (shift_params.x == KIND_RECONNECTION) s = shift_reconnection(params, base, camera, y1);
+    else if (shift_params.x == KIND_RANDOM_REPLAY) s = shift_random_replay(params, base, camera, y1);
+    else s = shift_hybrid(params, base, camera, y1);
+    uint o = OUT_STRIDE * i;
+    outputs[o] = vec4(s.valid ? 1.0 : 0.0, s.jacobian, float(s.vertex_count), 0.0);
+    PathRecord r = s.record;
+    outputs[o + 1u] = vec4(uintBitsToFloat(r.seed), uintBitsToFloat(r.info), uintBitsToFloat(r.lobes), uintBitsToFloat(r.rc_triangle));
+    outputs[o + 2u] = vec4(r.rc_pos, r.rc_pdf);
+    outputs[o + 3u] = vec4(r.rc_next, r.rc_geometry);
+    outputs[o + 4u] = vec4(r.suffix, r.rc_pdf_after);
+    outputs[o + 5u] = vec4(s.contribution, uintBitsToFloat(r.rc_next_triangle));
+    for (uint v = 0u; v < MAX_PATH_LENGTH; ++v) {
+        outputs[o + 6u + v] = vec4(v < s.vertex_count ? s.vertices[v] : vec3(0.0), 0.0);
+    }
+}
