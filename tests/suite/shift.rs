@@ -510,3 +510,79 @@ fn shift_random_replay_glsl_matches_rust() {
 fn shift_hybrid_glsl_matches_rust() {
     check_glsl_matches_rust(Kind::Hybrid);
 }
+
+/// The reconnection y1 -> x2 checked from the geometry alone, with the public BVH and BSDF:
+/// which of the failure causes the issue names apply.
+#[derive(Default, Debug)]
+struct Causes {
+    delta: usize,
+    occluded: usize,
+    too_short: usize,
+    back_facing: usize,
+}
+
+#[test]
+fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
+    use restir_pt::bsdf::{bsdf_eval_pdf, lobe_weights};
+    use restir_pt::bvh::{offset_ray_origin, trace_occluded};
+    let mut total = Causes::default();
+    let mut diverged = 0;
+    for name in ["mirror", "glass", "near-field", "cornell", "veach-door"] {
+        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+        let params = ShiftParams::for_scene(&scene);
+        let camera = scene.cameras[0].position;
+        for case in cases(&scene, 555, 4000) {
+            let (y1, x1) = (case.y1, case.base.vertices[0]);
+            let material = |v: &Vertex| scene.materials[scene.triangles[v.triangle as usize].material as usize];
+            let is_delta = |v: &Vertex| {
+                let m = material(v);
+                let (_, w_c, w_t) = lobe_weights(&m);
+                (w_c > 0.0 || w_t > 0.0) && m.roughness * m.roughness < restir_pt::bsdf::DELTA_ALPHA
+            };
+            let check = |result: &ShiftResult, what: &str| {
+                assert!(
+                    !result.valid && result.jacobian == 0.0 && result.contribution == Vec3::ZERO,
+                    "{name}: {what} must fail cleanly: {result:?}"
+                );
+            };
+            let rec = shift_reconnection(&scene, &params, &case.record, camera, y1);
+            if case.base.length() >= 2 && !case.base.vertices[1].is_escaped() {
+                let x2 = case.base.vertices[1];
+                let d = x2.pos - y1.pos;
+                let dir = d.normalize();
+                let facing = |n: Vec3, v: Vec3| if v.dot(n) > 0.0 { n } else { -n };
+                let origin = offset_ray_origin(y1.pos, facing(y1.normal, dir));
+                let target = offset_ray_origin(x2.pos, facing(x2.normal, -dir));
+                let wo = (camera - y1.pos).normalize();
+                let (f, _) = bsdf_eval_pdf(&material(&y1), y1.normal, wo, dir);
+                if is_delta(&y1) || is_delta(&x1) || is_delta(&x2) {
+                    check(&rec, "a reconnection at a delta vertex");
+                    total.delta += 1;
+                } else if d.length() < params.distance_threshold {
+                    check(&rec, "a too-short reconnection");
+                    total.too_short += 1;
+                } else if trace_occluded(&scene.nodes, &scene.triangles, origin, target - origin, 1.0 - 1e-4) {
+                    check(&rec, "an occluded reconnection");
+                    total.occluded += 1;
+                } else if f.max_element() == 0.0 {
+                    check(&rec, "a back-facing reconnection");
+                    total.back_facing += 1;
+                }
+            }
+            // A replay whose regenerated path has another length or other lobes must fail.
+            let replayed = generate_path(&scene, camera, y1, case.base.seed, case.base.length(), case.base.nee_end);
+            if replayed.as_ref().map_or(true, |y| y.lobes != case.base.lobes) {
+                check(
+                    &shift_random_replay(&scene, &params, &case.record, camera, y1),
+                    "a diverging replay",
+                );
+                diverged += 1;
+            }
+        }
+    }
+    eprintln!("clean failures: {total:?}, {diverged} diverging replays");
+    assert!(
+        total.delta > 0 && total.occluded > 0 && total.too_short > 0 && total.back_facing > 0 && diverged > 0,
+        "{total:?}, {diverged}"
+    );
+}
