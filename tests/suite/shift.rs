@@ -351,9 +351,9 @@ fn near_threshold(kind: Kind, scene: &Scene, params: &ShiftParams, case: &Case, 
 
 /// GLSL glsl/shift.glsl against src/shift.rs: 10^4 base paths per scene, each shifted on the GPU
 /// and in Rust. Validity, the rebuilt vertices (within 1e-4 of the scene's extent), the Jacobian
-/// and the contribution agree within 1e-4 relative (random replay: at most 0.1% of contributions
-/// between 1e-4 and 1e-3), the record's cached terms within 1e-3; inputs within 1e-3 of a
-/// threshold are excluded and counted (at most 1%).
+/// and the contribution agree within 1e-4 relative (random replay: within 1e-3, and at most 0.1%
+/// beyond 1e-4), the record's cached terms within 1e-3. Inputs within 1e-3 of the distance or
+/// roughness threshold are excluded and counted (at most 1%).
 fn check_glsl_matches_rust(kind: Kind) {
     use glam::Vec4;
     use restir_pt::render::{RenderSettings, SceneGpu};
@@ -460,13 +460,14 @@ fn check_glsl_matches_rust(kind: Kind) {
             for (what, a, b) in cached {
                 assert!(close(a, b, 1e-3), "{name} {kind:?} case {i}: {what} GLSL {a} vs Rust {b}");
             }
-            // Replay regenerates whole paths, and an NEE end seen nearly edge-on (d^2 / cos)
-            // magnifies last-bit differences in the replayed hit points: for replay, a few paths
-            // per 10^4 reach 2e-4. They are counted; all must stay within 1e-3.
             let scale = rust.contribution.max_element();
             let worst = (0..3)
                 .map(|c| (g[5][c] - rust.contribution[c]).abs() / scale)
                 .fold(0.0f32, f32::max);
+            // Replay regenerates whole paths on two different math libraries. Where an NEE end
+            // sees its light nearly edge-on, f(X) is proportional to that cosine and inherits the
+            // rounding of the regenerated positions: about 1 path in 10^4 reaches 2e-4. Replay is
+            // held to 1e-3 and at most 0.1% beyond 1e-4, counted; the others to 1e-4.
             let bound = if kind == Kind::RandomReplay { 1e-3 } else { 1e-4 };
             assert!(
                 worst <= bound,
