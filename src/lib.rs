@@ -8,6 +8,7 @@ pub mod cli;
 pub mod error;
 pub mod gltf_writer;
 pub mod gpu_types;
+pub mod gris;
 pub mod image_io;
 pub mod lights;
 pub mod path_record;

@@ -7,6 +7,7 @@ mod bsdf_oracle;
 mod bvh_oracle;
 mod cli;
 mod furnace;
+mod gris;
 mod layout;
 mod rng_oracle;
 mod robustness;
