@@ -119,7 +119,7 @@ fn cornell_camera_path(b: &mut GltfBuilder) {
     camera_path(b, CORNELL_EYE, Vec3::ZERO, Vec3::new(0.02, 0.0, 0.0), CORNELL_YFOV);
 }
 
-/// 1. The classic diffuse Cornell box (the default scene).
+/// Scene 1: The classic diffuse Cornell box (the default scene).
 pub fn cornell() -> String {
     let mut b = GltfBuilder::default();
     cornell_room(&mut b, CORNELL_LIGHT, CORNELL_LIGHT_SIZE);
@@ -129,7 +129,7 @@ pub fn cornell() -> String {
     b.finish("cornell", Vec3::ZERO)
 }
 
-/// 2. The Cornell box with five GGX conductor spheres at roughness 0.05 to 0.5, straddling the
+/// Scene 2: The Cornell box with five GGX conductor spheres at roughness 0.05 to 0.5, straddling the
 /// reconnection roughness threshold (0.2).
 pub fn cornell_glossy() -> String {
     let mut b = GltfBuilder::default();
@@ -164,7 +164,7 @@ fn wall_with_hole(origin: Vec3, u: Vec3, v: Vec3, hole: (f32, f32, f32, f32)) ->
         .fold(MeshData::default(), |acc, q| acc.merged(&q))
 }
 
-/// 3. A closed room lit only through the slit of a door left ajar, by a bright light in the
+/// Scene 3: A closed room lit only through the slit of a door left ajar, by a bright light in the
 /// closed hallway outside: indirect-dominated, multi-bounce.
 pub fn veach_door() -> String {
     let mut b = GltfBuilder::default();
@@ -218,7 +218,7 @@ pub fn veach_door() -> String {
     b.finish("veach-door", Vec3::ZERO)
 }
 
-/// 4. Surfaces 0.02 to 0.2 apart in the Cornell room: a slab hovering 0.02 above the floor, a box
+/// Scene 4: Surfaces 0.02 to 0.2 apart in the Cornell room: a slab hovering 0.02 above the floor, a box
 /// 0.05 from a wall, and two boxes 0.1 and 0.2 apart: reconnection distance tests and 1/d^2
 /// Jacobian spikes.
 pub fn near_field() -> String {
@@ -235,7 +235,7 @@ pub fn near_field() -> String {
     b.finish("near-field", Vec3::ZERO)
 }
 
-/// 5. A smooth glass sphere (IOR 1.5) between a small bright light and a diffuse wall: delta
+/// Scene 5: A smooth glass sphere (IOR 1.5) between a small bright light and a diffuse wall: delta
 /// vertices and caustics.
 pub fn glass() -> String {
     let mut b = GltfBuilder::default();
@@ -266,7 +266,7 @@ pub fn glass() -> String {
     b.finish("glass", Vec3::ZERO)
 }
 
-/// 6. A near-specular mirror (roughness 0.02, a delta lobe in the material model) on the right
+/// Scene 6: A near-specular mirror (roughness 0.02, a delta lobe in the material model) on the right
 /// wall of the Cornell room, seen directly and reflecting the red wall and the boxes:
 /// reconnection must move past the mirror vertex.
 pub fn mirror() -> String {
@@ -285,7 +285,7 @@ pub fn mirror() -> String {
     b.finish("mirror", Vec3::ZERO)
 }
 
-/// 7. A ground plane with a few objects under a constant sky: escaped (direction-only)
+/// Scene 7: A ground plane with a few objects under a constant sky: escaped (direction-only)
 /// reconnection vertices and NEE/BSDF MIS with the environment.
 pub fn env_ground() -> String {
     let mut b = GltfBuilder::default();
@@ -316,7 +316,7 @@ pub fn env_ground() -> String {
     b.finish("env-ground", Vec3::new(0.7, 0.8, 1.0))
 }
 
-/// 8. A closed U-shaped corridor whose light hides behind a baffle at the far end: light reaches
+/// Scene 8: A closed U-shaped corridor whose light hides behind a baffle at the far end: light reaches
 /// what the camera sees only after 4 to 6 diffuse bounces (round the two corners, then under the
 /// baffle).
 pub fn corridor() -> String {
@@ -346,7 +346,7 @@ pub fn corridor() -> String {
     b.finish("corridor", Vec3::ZERO)
 }
 
-/// 9. The white furnace: a diffuse sphere of albedo 1 inside a uniform environment of radiance 1.
+/// Scene 9: The white furnace: a diffuse sphere of albedo 1 inside a uniform environment of radiance 1.
 /// Camera 0 sees only the sphere; cameras 1 to 8 (the camera path) show it against the sky.
 pub fn furnace() -> String {
     let mut b = GltfBuilder::default();

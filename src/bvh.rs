@@ -158,7 +158,7 @@ impl Builder<'_> {
                     continue;
                 }
                 let cost = acc.half_area() * n as f32 + right_cost[k + 1];
-                if best.map_or(true, |(c, _, _)| cost < c) {
+                if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, k));
                 }
             }

@@ -1,6 +1,9 @@
 //! restir-pt: a Vulkan compute path tracer with ReSTIR PT reuse through explicit shift mappings.
 //! Every GLSL function an oracle mirrors has a Rust twin of the same name in the matching module.
 
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod bsdf;
 pub mod bundled_scenes;
 pub mod bvh;

@@ -127,7 +127,7 @@ impl ShiftResult {
     fn ok(record: PathRecord, jacobian: f32, vertices: Vec<Vertex>) -> ShiftResult {
         let contribution = record.contribution();
         // A non-finite or non-positive Jacobian counts as a failed shift, never as a value.
-        if !(jacobian.is_finite() && jacobian > 0.0) || !contribution.is_finite() {
+        if !jacobian.is_finite() || jacobian <= 0.0 || !contribution.is_finite() {
             return ShiftResult::failed();
         }
         ShiftResult {
@@ -150,7 +150,7 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
     let (_, w_c, w_t) = lobe_weights(m);
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
-    (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || rough_ggx)
+    (w_c <= 0.0 && w_t <= 0.0) || rough_ggx
 }
 
 /// The reconnection test for the pair (prev, cur): both rough and far enough apart.

@@ -41,11 +41,11 @@ fn glb(mut json: Value) -> Vec<u8> {
     let bin = decode_base64(uri.split(',').nth(1).expect("data URI"));
     json["buffers"][0].as_object_mut().expect("buffer object").remove("uri");
     let mut text = serde_json::to_vec(&json).expect("JSON values serialise");
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let mut bin = bin;
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();

@@ -343,7 +343,7 @@ impl Loader<'_> {
                     format!("mesh {}: index {bad} is out of range ({} vertices)", mesh.index(), positions.len())
                 ));
             }
-            if indices.len() % 3 != 0 {
+            if !indices.len().is_multiple_of(3) {
                 self.warn(format!("mesh {}: {} trailing indices ignored", mesh.index(), indices.len() % 3));
             }
             let material = match prim.material().index() {

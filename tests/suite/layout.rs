@@ -64,7 +64,10 @@ macro_rules! rust_fields {
     };
 }
 
-fn scene_structs() -> Vec<(&'static str, usize, Vec<(String, u32)>)> {
+/// (struct name, size in bytes, (field, offset) pairs) of a Rust twin.
+type StructLayout = (&'static str, usize, Vec<(String, u32)>);
+
+fn scene_structs() -> Vec<StructLayout> {
     vec![
         rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, pad),
         rust_fields!(Triangle: v0, material, e1, emitter, e2, pad),
@@ -75,7 +78,7 @@ fn scene_structs() -> Vec<(&'static str, usize, Vec<(String, u32)>)> {
     ]
 }
 
-fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<(&'static str, usize, Vec<(String, u32)>)>) -> usize {
+fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<StructLayout>) -> usize {
     let spirv = compile_kernel(kernel, defines).expect("kernel compiles");
     let r = reflect(&spirv);
     let mut checked = 0;

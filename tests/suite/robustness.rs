@@ -167,7 +167,7 @@ fn robustness_impossible_resolutions_fail_before_gpu_allocation() {
     // 128 MiB storage-binding limit: a typed error naming the limit, before allocating it.
     let ctx = gpu();
     if ctx.info.max_storage_buffer_range < 4096 * 4096 * 16 {
-        let err = render_at(4096, 4096).err().expect("binding too large");
+        let err = render_at(4096, 4096).expect_err("binding too large");
         let typed = err.downcast_ref::<GpuError>();
         assert!(matches!(typed, Some(GpuError::BindingTooLarge { .. })), "{err:#}");
         assert!(format!("{err:#}").contains("maxStorageBufferRange"));

@@ -572,7 +572,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
             }
             // A replay whose regenerated path has another length or other lobes must fail.
             let replayed = generate_path(&scene, camera, y1, case.base.seed, case.base.length(), case.base.nee_end);
-            if replayed.as_ref().map_or(true, |y| y.lobes != case.base.lobes) {
+            if replayed.as_ref().is_none_or(|y| y.lobes != case.base.lobes) {
                 check(
                     &shift_random_replay(&scene, &params, &case.record, camera, y1),
                     "a diverging replay",
