@@ -12,21 +12,15 @@
 #include "rng.glsl"
 
 const float RAY_TMAX = 1e30;
-// Shadow rays stop this fraction short of their (offset) end point.
-const float SHADOW_EPSILON = 1e-4;
 const float RR_MAX_SURVIVAL = 0.95;
 const uint RR_START_DEPTH = 3u;
 
 
-// Tests the segment from `origin` (already offset off the surface at x) to the light sample.
-// The light point is offset off the emitter too and the ray runs between the two offset points:
-// offsetting one end only moves a grazing far hit by more than any epsilon along the ray.
-bool shadow_ray_occluded(vec3 origin, vec3 x, LightSample ls) {
-    if (ls.triangle == NO_EMITTER) return trace_occluded(origin, ls.dir, RAY_TMAX);
+// Whether the light sample is hidden from the shading point x (geometric normal ng).
+bool shadow_ray_occluded(vec3 x, vec3 ng, LightSample ls) {
+    if (ls.triangle == NO_EMITTER) return trace_occluded(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng), ls.dir, RAY_TMAX);
     Triangle light = triangles[ls.triangle];
-    vec3 nl = normalize(cross(light.e1, light.e2));
-    vec3 target = offset_ray_origin(x + ls.dir * ls.dist, dot(nl, ls.dir) < 0.0 ? nl : -nl);
-    return trace_occluded(origin, target - origin, 1.0 - SHADOW_EPSILON);
+    return segment_occluded(x, ng, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)));
 }
 
 struct PathState {
@@ -83,8 +77,7 @@ bool path_step(inout PathState s) {
         float bsdf_pdf;
         vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
-            vec3 origin = offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng);
-            if (!shadow_ray_occluded(origin, x, ls)) {
+            if (!shadow_ray_occluded(x, ng, ls)) {
                 s.radiance += s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
             }
         }

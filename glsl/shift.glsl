@@ -10,7 +10,6 @@
 #include "path_record.glsl"
 #include "rng.glsl"
 
-const float SHIFT_SHADOW_EPSILON = 1e-4;
 const float SHIFT_RAY_TMAX = 1e30;
 
 struct ShiftParams {
@@ -90,15 +89,10 @@ void direction(Vertex from, Vertex to, out vec3 dir, out float dist) {
     }
 }
 
-// Both ends are offset off their surfaces and the ray runs between the offset points.
 bool visible(Vertex from, Vertex to) {
-    vec3 dir;
-    float dist;
-    direction(from, to, dir, dist);
-    vec3 origin = offset_ray_origin(from.pos, dot(dir, from.normal) > 0.0 ? from.normal : -from.normal);
-    if (vertex_is_escaped(to)) return !trace_occluded(origin, dir, SHIFT_RAY_TMAX);
-    vec3 target = offset_ray_origin(to.pos, dot(-dir, to.normal) > 0.0 ? to.normal : -to.normal);
-    return !trace_occluded(origin, target - origin, 1.0 - SHIFT_SHADOW_EPSILON);
+    if (!vertex_is_escaped(to)) return !segment_occluded(from.pos, from.normal, to.pos, to.normal);
+    vec3 origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal);
+    return !trace_occluded(origin, to.pos, SHIFT_RAY_TMAX);
 }
 
 vec3 end_emission(Vertex from, Vertex end) {

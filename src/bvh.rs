@@ -273,6 +273,19 @@ pub fn trace_occluded(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec
     bvh_traverse(nodes, triangles, o, d, tmax, true).triangle != NO_HIT
 }
 
+/// Segment tests stop this fraction short of their (offset) end point.
+pub const SEGMENT_EPSILON: f32 = 1e-4;
+
+/// Twin of GLSL `segment_occluded`: whether anything blocks the segment between surface points
+/// p (normal np) and q (normal nq). Both ends are offset off their surfaces, each towards the
+/// other: offsetting one end only moves a grazing far hit by more than any epsilon.
+pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: Vec3, q: Vec3, nq: Vec3) -> bool {
+    let d = q - p;
+    let origin = offset_ray_origin(p, if d.dot(np) > 0.0 { np } else { -np });
+    let target = offset_ray_origin(q, if d.dot(nq) < 0.0 { nq } else { -nq });
+    trace_occluded(nodes, triangles, origin, target - origin, 1.0 - SEGMENT_EPSILON)
+}
+
 /// Twin of GLSL `offset_ray_origin` (Wächter and Binder, Ray Tracing Gems ch. 6).
 pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
     const ORIGIN: f32 = 1.0 / 32.0;

@@ -17,7 +17,7 @@
 use glam::Vec3;
 
 use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
-use crate::bvh::{offset_ray_origin, trace_closest, trace_occluded, NO_HIT};
+use crate::bvh::{offset_ray_origin, segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::NO_EMITTER;
 use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
 use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
@@ -28,8 +28,6 @@ use crate::scene::Scene;
 pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
 /// The distance threshold as a fraction of the scene's smallest bounding-box extent.
 pub const DEFAULT_DISTANCE_FRACTION: f32 = 0.03;
-/// Shadow rays stop this fraction short of their target, as in the path tracer.
-const SHADOW_EPSILON: f32 = 1e-4;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShiftParams {
@@ -180,18 +178,12 @@ fn direction(from: &Vertex, to: &Vertex) -> (Vec3, f32) {
     }
 }
 
-/// Whether the segment between two vertices is free. Both ends are offset off their surfaces
-/// and the ray runs between the offset points: at grazing angles an offset at one end only moves
-/// the far hit by far more than any epsilon along the ray.
 fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
-    let (dir, _) = direction(from, to);
-    let facing = |n: Vec3, d: Vec3| if d.dot(n) > 0.0 { n } else { -n };
-    let origin = offset_ray_origin(from.pos, facing(from.normal, dir));
-    if to.is_escaped() {
-        return !trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
+    if !to.is_escaped() {
+        return !segment_occluded(&scene.nodes, &scene.triangles, from.pos, from.normal, to.pos, to.normal);
     }
-    let target = offset_ray_origin(to.pos, facing(to.normal, -dir));
-    !trace_occluded(&scene.nodes, &scene.triangles, origin, target - origin, 1.0 - SHADOW_EPSILON)
+    let origin = offset_ray_origin(from.pos, if to.pos.dot(from.normal) > 0.0 { from.normal } else { -from.normal });
+    !trace_occluded(&scene.nodes, &scene.triangles, origin, to.pos, 1e30)
 }
 
 /// Radiance emitted by the end vertex `end` towards `from`.
