@@ -32,5 +32,6 @@ vec4 rng_uniform4(uint seed, uint vertex, uint stream) {
 const uint STREAM_CAMERA = 0u;
 const uint STREAM_BSDF = 1u;
 const uint STREAM_LIGHT = 2u;
+const uint STREAM_RESAMPLE = 3u;  // ReSTIR's choices among candidates, keyed by a pass seed
 
 #endif

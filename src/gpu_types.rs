@@ -99,3 +99,90 @@ pub struct FrameParams {
     pub flags: u32,
     pub emitter_count: u32,
 }
+
+/// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std140.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct ReuseParams {
+    pub prev_cam_position: [f32; 4],
+    pub prev_cam_right: [f32; 4],
+    pub prev_cam_up: [f32; 4],
+    pub prev_cam_forward: [f32; 4],
+    pub roughness_threshold: f32,
+    pub distance_threshold: f32,
+    pub m_cap: f32,
+    pub radius: f32,
+    pub normal_threshold: f32,
+    pub depth_threshold: f32,
+    pub frame_index: u32,
+    pub candidates: u32,
+    pub neighbours: u32,
+    pub temporal_valid: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+/// A pixel's primary hit in one frame (glsl/restir_bindings.glsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct Surface {
+    pub pos: [f32; 3],
+    pub triangle: u32,
+    pub camera: [f32; 3],
+    pub depth: f32,
+}
+
+/// The first half of a stored reservoir (glsl/reservoir.glsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct ReservoirHead {
+    pub seed: u32,
+    pub info: u32,
+    pub lobes: u32,
+    pub rc_triangle: u32,
+    pub rc_pos: [f32; 3],
+    pub rc_pdf: f32,
+    pub rc_next: [f32; 3],
+    pub rc_geometry: f32,
+}
+
+/// The second half of a stored reservoir, with W and M (glsl/reservoir.glsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct ReservoirTail {
+    pub suffix: [f32; 3],
+    pub rc_pdf_after: f32,
+    pub contribution: [f32; 3],
+    pub rc_next_triangle: u32,
+    /// The unbiased contribution weight W.
+    pub weight: f32,
+    /// The confidence weight M.
+    pub confidence: f32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+/// The per-frame counters of the ReSTIR kernels (glsl/restir_bindings.glsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct RestirStats {
+    pub max_loop_iterations: u32,
+    pub loop_budget_cut_groups: u32,
+    pub shifts_attempted: u32,
+    pub shifts_failed: u32,
+    pub nonfinite_weights: u32,
+    pub candidates_dropped: u32,
+    pub nonfinite_pixels: u32,
+    pub stats_pad: u32,
+}
+
+/// The push constants of the ReSTIR kernels: which slots a pass reads and writes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct RestirPass {
+    pub in_slot: u32,
+    pub out_slot: u32,
+    pub prev_slot: u32,
+    pub surface_slot: u32,
+    pub pass_seed: u32,
+}

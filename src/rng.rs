@@ -5,6 +5,8 @@ use glam::{UVec4, Vec4};
 pub const STREAM_CAMERA: u32 = 0;
 pub const STREAM_BSDF: u32 = 1;
 pub const STREAM_LIGHT: u32 = 2;
+/// ReSTIR's choices among candidates, keyed by a pass seed.
+pub const STREAM_RESAMPLE: u32 = 3;
 
 /// The 4D permuted congruential hash of Jarzynski and Olano (JCGT 2020).
 pub fn pcg4d(v: UVec4) -> UVec4 {

@@ -1,11 +1,15 @@
-//! Rendering on the GPU: scene upload, settings, the path tracer and its image.
+//! Rendering on the GPU: scene upload, settings, the path tracer, ReSTIR PT and their images.
 
 mod image;
 mod path_tracer;
+mod restir;
+mod restir_settings;
 mod scene_gpu;
 mod settings;
 
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
+pub use restir::{FrameStats, Restir, PASS_NAMES};
+pub use restir_settings::{ReuseMis, RestirSettings, ShiftKind, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_ROUNDS};
 pub use scene_gpu::SceneGpu;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};

@@ -15,4 +15,5 @@ mod sampling_oracle;
 mod sampling_statistics;
 mod scene_loader;
 mod scenes;
+mod restir;
 mod shift;

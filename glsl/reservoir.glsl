@@ -1,0 +1,92 @@
+// ReSTIR reservoirs: a path record, its unbiased contribution weight W and its confidence M.
+// Stored as two 48-byte halves in separate bindings, so that a 1920x1080 frame needs 99.5 MB
+// per binding, under lavapipe's 128 MiB limit (one 96-byte array would need 199 MB).
+// Twins: ReservoirHead and ReservoirTail in src/gpu_types.rs (layout test).
+#ifndef RESERVOIR_GLSL
+#define RESERVOIR_GLSL
+
+#include "path_record.glsl"
+
+struct Reservoir {
+    PathRecord record;
+    float W;
+    float M;
+};
+
+struct ReservoirHead {
+    uint seed;
+    uint info;
+    uint lobes;
+    uint rc_triangle;
+    vec3 rc_pos;
+    float rc_pdf;
+    vec3 rc_next;
+    float rc_geometry;
+};
+
+struct ReservoirTail {
+    vec3 suffix;
+    float rc_pdf_after;
+    vec3 contribution;
+    uint rc_next_triangle;
+    float weight;       // W
+    float confidence;   // M
+    uint pad0;
+    uint pad1;
+};
+
+// The target function p̂: luminance of the path contribution. Every channel has a positive
+// weight, so p̂ > 0 wherever f is non-zero, as unbiased resampling requires.
+float target_function(vec3 contribution) {
+    return dot(contribution, vec3(0.2126, 0.7152, 0.0722));
+}
+
+Reservoir reservoir_empty() {
+    PathRecord r = PathRecord(0u, 0u, 0u, 0xffffffffu, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0.0, vec3(0.0), 0xffffffffu);
+    return Reservoir(r, 0.0, 0.0);
+}
+
+ReservoirHead reservoir_head(Reservoir r) {
+    PathRecord p = r.record;
+    return ReservoirHead(p.seed, p.info, p.lobes, p.rc_triangle, p.rc_pos, p.rc_pdf, p.rc_next, p.rc_geometry);
+}
+
+ReservoirTail reservoir_tail(Reservoir r) {
+    PathRecord p = r.record;
+    return ReservoirTail(p.suffix, p.rc_pdf_after, p.contribution, p.rc_next_triangle, r.W, r.M, 0u, 0u);
+}
+
+Reservoir reservoir_join(ReservoirHead h, ReservoirTail t) {
+    PathRecord p = PathRecord(h.seed, h.info, h.lobes, h.rc_triangle, h.rc_pos, h.rc_pdf, h.rc_next, h.rc_geometry, t.suffix,
+                              t.rc_pdf_after, t.contribution, t.rc_next_triangle);
+    return Reservoir(p, t.weight, t.confidence);
+}
+
+// Streaming weighted selection: after add() of candidates with weights w_i, `chosen` is candidate
+// i with probability w_i / sum w and W = sum w / p̂(chosen).
+struct Resampler {
+    PathRecord chosen;
+    float chosen_target;
+    float weight_sum;
+    float confidence;
+};
+
+Resampler resampler_begin() {
+    return Resampler(reservoir_empty().record, 0.0, 0.0, 0.0);
+}
+
+// `u` uniform in [0, 1); `w` finite and positive.
+void resampler_add(inout Resampler s, PathRecord y, float target, float w, float u) {
+    s.weight_sum += w;
+    if (u * s.weight_sum < w) {
+        s.chosen = y;
+        s.chosen_target = target;
+    }
+}
+
+Reservoir resampler_finish(Resampler s) {
+    float W = s.weight_sum > 0.0 ? s.weight_sum / s.chosen_target : 0.0;
+    return Reservoir(s.chosen, W, s.confidence);
+}
+
+#endif

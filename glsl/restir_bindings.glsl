@@ -1,0 +1,133 @@
+// The bindings every ReSTIR PT kernel shares (set 0, after the scene's 0-4), with loads and
+// stores by slot. Twins: ReuseParams, Surface, ReservoirHead/Tail, RestirStats and RestirPass
+// in src/gpu_types.rs. Slots are chosen by push constants, so that one descriptor set serves
+// every pass: reservoir slots 0-2 rotate between initial candidates, reuse rounds and the
+// previous frame's result; surface slots 0-1 alternate between frames.
+#ifndef RESTIR_BINDINGS_GLSL
+#define RESTIR_BINDINGS_GLSL
+
+#include "scene_bindings.glsl"
+#include "reservoir.glsl"
+#include "loop_budget.glsl"
+
+layout(std140, set = 0, binding = 5) uniform ReuseParams {
+    vec4 prev_cam_position;  // the previous frame's camera, laid out like FrameParams' camera
+    vec4 prev_cam_right;
+    vec4 prev_cam_up;
+    vec4 prev_cam_forward;
+    float roughness_threshold;
+    float distance_threshold;
+    float m_cap;             // temporal confidence cap, as a multiple of the current M
+    float radius;            // spatial reuse radius in pixels
+    float normal_threshold;  // neighbours need dot(n, n') >= this
+    float depth_threshold;   // and |depth - depth'| <= this * depth
+    uint frame_index;
+    uint candidates;         // initial paths per pixel
+    uint neighbours;         // spatial neighbours per round
+    uint temporal_valid;     // 1 if the previous frame's reservoirs and surfaces exist
+    uint pad0;
+    uint pad1;
+};
+
+// The primary hit of a pixel in one frame: the domain of that pixel's paths.
+struct Surface {
+    vec3 pos;
+    uint triangle;   // NO_HIT: the camera ray escaped
+    vec3 camera;
+    float depth;     // distance from the camera
+};
+
+layout(std430, set = 0, binding = 6) buffer Surfaces0 { Surface surfaces0[]; };
+layout(std430, set = 0, binding = 7) buffer Surfaces1 { Surface surfaces1[]; };
+layout(std430, set = 0, binding = 8) buffer Heads0 { ReservoirHead heads0[]; };
+layout(std430, set = 0, binding = 9) buffer Tails0 { ReservoirTail tails0[]; };
+layout(std430, set = 0, binding = 10) buffer Heads1 { ReservoirHead heads1[]; };
+layout(std430, set = 0, binding = 11) buffer Tails1 { ReservoirTail tails1[]; };
+layout(std430, set = 0, binding = 12) buffer Heads2 { ReservoirHead heads2[]; };
+layout(std430, set = 0, binding = 13) buffer Tails2 { ReservoirTail tails2[]; };
+layout(std430, set = 0, binding = 14) buffer Direct { vec4 direct[]; };     // rgb: emission seen at the primary hit
+layout(std430, set = 0, binding = 15) buffer Accum { vec4 accum[]; };       // rgb: sum of frames, w: count
+layout(std430, set = 0, binding = 16) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of squares
+layout(std430, set = 0, binding = 17) buffer Stats {
+    uint max_loop_iterations;
+    uint loop_budget_cut_groups;
+    uint shifts_attempted;
+    uint shifts_failed;
+    uint nonfinite_weights;
+    uint candidates_dropped;
+    uint nonfinite_pixels;
+    uint stats_pad;
+};
+
+layout(push_constant) uniform RestirPass {
+    uint in_slot;
+    uint out_slot;
+    uint prev_slot;
+    uint surface_slot;   // the current frame's surfaces; the previous frame's are the other slot
+    uint pass_seed;      // distinguishes the random choices of passes and rounds
+};
+
+// if/else rather than ?:, which glslang's optimiser mistypes for structs read from buffers.
+Surface load_surface(uint slot, uint pixel) {
+    if (slot == 0u) return surfaces0[pixel];
+    return surfaces1[pixel];
+}
+
+void store_surface(uint slot, uint pixel, Surface s) {
+    if (slot == 0u) surfaces0[pixel] = s;
+    else surfaces1[pixel] = s;
+}
+
+Reservoir load_reservoir(uint slot, uint pixel) {
+    if (slot == 0u) return reservoir_join(heads0[pixel], tails0[pixel]);
+    if (slot == 1u) return reservoir_join(heads1[pixel], tails1[pixel]);
+    return reservoir_join(heads2[pixel], tails2[pixel]);
+}
+
+void store_reservoir(uint slot, uint pixel, Reservoir r) {
+    ReservoirHead h = reservoir_head(r);
+    ReservoirTail t = reservoir_tail(r);
+    if (slot == 0u) {
+        heads0[pixel] = h;
+        tails0[pixel] = t;
+    } else if (slot == 1u) {
+        heads1[pixel] = h;
+        tails1[pixel] = t;
+    } else {
+        heads2[pixel] = h;
+        tails2[pixel] = t;
+    }
+}
+
+// Per-invocation counts, summed per subgroup into Stats by report_pass_stats().
+uint local_shifts_attempted = 0u;
+uint local_shifts_failed = 0u;
+uint local_nonfinite_weights = 0u;
+uint local_candidates_dropped = 0u;
+uint local_nonfinite_pixels = 0u;
+
+// Call once at the end of main(), from uniform control flow.
+void report_pass_stats() {
+    uint iterations = subgroup_loop_iterations();
+    bool cut = subgroup_loop_budget_cut();
+    uint attempted = subgroupAdd(local_shifts_attempted);
+    uint failed = subgroupAdd(local_shifts_failed);
+    uint nonfinite = subgroupAdd(local_nonfinite_weights);
+    uint dropped = subgroupAdd(local_candidates_dropped);
+    uint pixels = subgroupAdd(local_nonfinite_pixels);
+    if (subgroupElect()) {
+        atomicMax(max_loop_iterations, iterations);
+        if (cut) atomicAdd(loop_budget_cut_groups, 1u);
+        if (attempted > 0u) atomicAdd(shifts_attempted, attempted);
+        if (failed > 0u) atomicAdd(shifts_failed, failed);
+        if (nonfinite > 0u) atomicAdd(nonfinite_weights, nonfinite);
+        if (dropped > 0u) atomicAdd(candidates_dropped, dropped);
+        if (pixels > 0u) atomicAdd(nonfinite_pixels, pixels);
+    }
+}
+
+bool is_finite(float x) {
+    return !isnan(x) && !isinf(x);
+}
+
+#endif

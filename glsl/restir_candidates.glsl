@@ -1,0 +1,90 @@
+// Initial candidates of ReSTIR PT: one traced path from the pixel's primary hit offers every
+// prefix that ends on a light, by NEE at a vertex or by a BSDF-sampled hit right after a delta
+// lobe. These two end types partition the paths (NEE cannot reach past a delta lobe, and a BSDF
+// hit after a non-delta lobe is left to NEE), so each path has exactly one way to be offered and
+// needs no further MIS weight; the shifts keep the lobe before the end, hence the partition.
+// The paths are built exactly as generate_path() in shift.glsl regenerates them from the seed.
+#ifndef RESTIR_CANDIDATES_GLSL
+#define RESTIR_CANDIDATES_GLSL
+
+#include "restir_bindings.glsl"
+#include "shift.glsl"
+
+// Offers the path `q` with weight p̂(q) * `scale` (the candidate's unbiased contribution weight
+// in primary sample space is 1; `scale` is the MIS weight 1/N among N traced paths).
+void offer_candidate(inout Resampler s, Path q, ShiftParams params, float scale, float u) {
+    PathRecord record;
+    if (!record_path(q, params, record)) {
+        local_candidates_dropped += 1u;
+        return;
+    }
+    float target = target_function(record.contribution);
+    float w = target * scale;
+    if (!is_finite(w)) {
+        local_nonfinite_weights += 1u;
+        return;
+    }
+    if (w > 0.0) resampler_add(s, record, target, w, u);
+}
+
+// Streams every light-ending prefix of at most `max_length` vertices of the path from y1 with
+// `seed` into `s`.
+void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed, uint max_length, ShiftParams params,
+                            float scale) {
+    Path p;
+    p.seed = seed;
+    p.camera = camera;
+    p.count = 1u;
+    p.nee_end = false;
+    p.vertices[0] = y1;
+    p.contribution = vec3(0.0);
+    vec3 prefix = vec3(1.0);
+    vec3 prev_pos = camera;
+    for (uint i = 1u; i < max_length; ++i) {
+        loop_tick();
+        Vertex x = p.vertices[i - 1u];
+        if (vertex_is_escaped(x)) break;
+        vec3 wo = normalize(prev_pos - x.pos);
+        Material m = material_of(x);
+        vec4 u = rng_uniform4(seed, i, STREAM_RESAMPLE);
+
+        LightSample ls = sample_light(x.pos, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
+        if (ls.pdf > 0.0) {
+            Vertex light = ls.triangle == NO_EMITTER ? vertex_escaped(ls.dir) : vertex_on_surface(ls.triangle, x.pos + ls.dir * ls.dist);
+            float bsdf_pdf;
+            vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
+            if (max_component(f_cos) > 0.0 && visible(x, light)) {
+                Path q = p;
+                q.count = i + 1u;
+                q.nee_end = true;
+                q.vertices[i] = light;
+                q.lobes[i - 1u] = LOBE_NONE;
+                q.weights[i - 1u] = f_cos / ls.pdf;
+                q.contribution = prefix * q.weights[i - 1u] * end_emission(x, light);
+                if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.x);
+            }
+        }
+
+        BsdfSample b = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
+        if (b.lobe == LOBE_NONE) break;
+        vec3 side = dot(b.wi, x.normal) > 0.0 ? x.normal : -x.normal;
+        Hit hit = trace_closest(offset_ray_origin(x.pos, side), b.wi, SHIFT_RAY_TMAX);
+        Vertex next = hit.triangle == NO_HIT ? vertex_escaped(b.wi) : hit_vertex(hit);
+        p.lobes[i - 1u] = b.lobe;
+        p.weights[i - 1u] = b.weight;
+        p.vertices[i] = next;
+        p.count = i + 1u;
+        prefix *= b.weight;
+        if ((b.lobe & LOBE_DELTA) != 0u) {
+            vec3 c = prefix * end_emission(x, next);
+            if (max_component(c) > 0.0) {
+                Path q = p;
+                q.contribution = c;
+                offer_candidate(s, q, params, scale, u.y);
+            }
+        }
+        prev_pos = x.pos;
+    }
+}
+
+#endif

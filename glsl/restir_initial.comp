@@ -1,0 +1,46 @@
+#version 460
+// ReSTIR PT pass 1: the pixel's primary hit (its surface and the emission seen there) and the
+// initial reservoir from `candidates` traced paths (restir_candidates.glsl).
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "restir_candidates.glsl"
+#include "camera.glsl"
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    bool inside = p.x < width && p.y < height;
+    uint pixel = p.y * width + p.x;
+    if (inside) {
+        uint first = frame_index * candidates;
+        uint seed0 = path_seed(pixel, first, render_seed);
+        vec4 jitter = rng_uniform4(seed0, 0u, STREAM_CAMERA);
+        vec3 camera = cam_position.xyz;
+        vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
+        Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
+        Surface surface = Surface(vec3(0.0), NO_HIT, camera, 0.0);
+        vec3 emitted = vec3(0.0);
+        Resampler s = resampler_begin();
+        if (hit.triangle == NO_HIT) {
+            if (SCENE_ENVIRONMENT != 0) emitted = scene_env.rgb;
+        } else {
+            Vertex y1 = hit_vertex(hit);
+            surface = Surface(y1.pos, hit.triangle, camera, hit.t);
+            Triangle tri = triangles[hit.triangle];
+            if (SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER) emitted = emitted_radiance(tri, -dir);
+            ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
+            uint max_length = min(max_depth, MAX_PATH_LENGTH);
+            float scale = 1.0 / float(candidates);
+            for (uint c = 0u; c < candidates; ++c) {
+                loop_tick();
+                stream_path_candidates(s, camera, y1, path_seed(pixel, first + c, render_seed), max_length, params, scale);
+            }
+            s.confidence = float(candidates);
+        }
+        store_surface(surface_slot, pixel, surface);
+        direct[pixel] = vec4(emitted, 0.0);
+        store_reservoir(out_slot, pixel, resampler_finish(s));
+    }
+    report_pass_stats();
+}

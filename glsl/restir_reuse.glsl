@@ -1,0 +1,147 @@
+// GRIS across pixels and frames (../shared/docs/math.md sections 2-4): inputs from other domains
+// are shifted into the canonical pixel's domain, weighted by resampling MIS weights computed with
+// inverse shifts, and one is chosen. Twin of src/gris.rs (mis_weight, resample), whose toy test
+// checks the estimator; SHIFT_MODE and MIS_MODE select the shift and the MIS at compile time.
+#ifndef RESTIR_REUSE_GLSL
+#define RESTIR_REUSE_GLSL
+
+#include "restir_bindings.glsl"
+#include "shift.glsl"
+
+#define SHIFT_RECONNECTION 0
+#define SHIFT_REPLAY 1
+#define SHIFT_HYBRID 2
+#define MIS_GBH 0
+#define MIS_PAIRWISE 1
+#ifndef SHIFT_MODE
+#define SHIFT_MODE SHIFT_HYBRID
+#endif
+#ifndef MIS_MODE
+#define MIS_MODE MIS_GBH
+#endif
+
+// Canonical input plus up to 8 neighbours.
+const uint MAX_INPUTS = 9u;
+
+// One input of a resampling: a reservoir from the domain (camera, primary hit x1), and its
+// confidence weight c.
+struct ReuseInput {
+    Reservoir res;
+    vec3 camera;
+    Vertex x1;
+    float confidence;
+};
+
+// The inputs of the current resampling, 0 the canonical one. A global rather than a parameter:
+// glslang's optimiser mistypes arrays of these structs passed by value.
+ReuseInput inputs[MAX_INPUTS];
+
+Vertex surface_vertex(Surface s) {
+    return vertex_on_surface(s.triangle, s.pos);
+}
+
+ShiftParams reuse_shift_params() {
+    return ShiftParams(roughness_threshold, distance_threshold);
+}
+
+// The selected shift of `base` into the domain (camera, y1); every inverse is the same shift back.
+ShiftResult shift_path(PathRecord base, vec3 camera, Vertex y1) {
+    local_shifts_attempted += 1u;
+#if SHIFT_MODE == SHIFT_RECONNECTION
+    ShiftResult s = shift_reconnection(reuse_shift_params(), base, camera, y1);
+#elif SHIFT_MODE == SHIFT_REPLAY
+    ShiftResult s = shift_random_replay(reuse_shift_params(), base, camera, y1);
+#else
+    ShiftResult s = shift_hybrid(reuse_shift_params(), base, camera, y1);
+#endif
+    if (!s.valid) local_shifts_failed += 1u;
+    return s;
+}
+
+// p̂_{<-l}(y) = p̂_l(T_l^{-1}(y)) |(T_l^{-1})'(y)| for y in the canonical domain; 0 where y
+// cannot be shifted into domain l. A non-finite value counts as a failed shift.
+float target_from(ReuseInput l, PathRecord y) {
+    ShiftResult s = shift_path(y, l.camera, l.x1);
+    if (!s.valid) return 0.0;
+    float t = target_function(s.contribution) * s.jacobian;
+    if (!is_finite(t)) {
+        local_nonfinite_weights += 1u;
+        local_shifts_failed += 1u;
+        return 0.0;
+    }
+    return t;
+}
+
+// m_i(y) for input i's sample shifted to y (p̂(y) = p0, shift Jacobian `jacobian`).
+float mis_weight(uint n, uint i, PathRecord y, float p0, float jacobian) {
+    // For input i itself the inverse shift returns its own sample, whose p̂ it carries.
+    float own = i == 0u ? p0 : target_function(inputs[i].res.record.contribution) / jacobian;
+#if MIS_MODE == MIS_GBH
+    float numerator = inputs[i].confidence * own;
+    float total = numerator;
+    if (i != 0u) total += inputs[0].confidence * p0;
+    for (uint l = 1u; l < n; ++l) {
+        loop_tick();
+        if (l != i) total += inputs[l].confidence * target_from(inputs[l], y);
+    }
+    return total > 0.0 ? numerator / total : 0.0;
+#else
+    // Defensive pairwise MIS: the canonical input against each neighbour in turn.
+    if (n == 1u) return 1.0;
+    float k = float(n - 1u);
+    float canonical = inputs[0].confidence * p0 / k;
+    if (i != 0u) {
+        float neighbour = inputs[i].confidence * own;
+        return neighbour + canonical > 0.0 ? neighbour / (neighbour + canonical) / (k + 1.0) : 0.0;
+    }
+    float sum = 1.0;
+    for (uint l = 1u; l < n; ++l) {
+        loop_tick();
+        float neighbour = inputs[l].confidence * target_from(inputs[l], y);
+        sum += neighbour + canonical > 0.0 ? canonical / (neighbour + canonical) : 1.0;
+    }
+    return sum / (k + 1.0);
+#endif
+}
+
+// Resamples inputs[0..n-1] (0: the canonical pixel's own reservoir) into one reservoir of the
+// canonical domain; `seed` keys the choice.
+Reservoir resample_inputs(uint n, uint seed) {
+    Resampler s = resampler_begin();
+    for (uint i = 0u; i < n; ++i) {
+        loop_tick();
+        s.confidence += inputs[i].confidence;
+        // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
+        if (!(inputs[i].res.W > 0.0)) continue;
+        PathRecord y = inputs[i].res.record;
+        float jacobian = 1.0;
+        if (i != 0u) {
+            ShiftResult shifted = shift_path(y, inputs[0].camera, inputs[0].x1);
+            if (!shifted.valid) continue;
+            y = shifted.record;
+            jacobian = shifted.jacobian;
+        }
+        float p0 = target_function(y.contribution);
+        float w = mis_weight(n, i, y, p0, jacobian) * p0 * inputs[i].res.W * jacobian;
+        if (!is_finite(w)) {
+            local_nonfinite_weights += 1u;
+            if (i != 0u) local_shifts_failed += 1u;
+            continue;
+        }
+        if (w > 0.0) resampler_add(s, y, p0, w, rng_uniform4(seed, i, STREAM_RESAMPLE).x);
+    }
+    return resampler_finish(s);
+}
+
+// Whether a neighbour's primary hit is similar enough to the canonical one to be reused: both
+// hit a surface, normals agree, and the neighbour's depth agrees with the canonical point's
+// distance from the neighbour's camera.
+bool similar_surfaces(Surface canonical, Surface other) {
+    if (canonical.triangle == NO_HIT || other.triangle == NO_HIT) return false;
+    vec3 n0 = surface_vertex(canonical).normal;
+    vec3 n1 = surface_vertex(other).normal;
+    float expected = length(canonical.pos - other.camera);
+    return abs(dot(n0, n1)) >= normal_threshold && abs(other.depth - expected) <= depth_threshold * other.depth;
+}
+
+#endif

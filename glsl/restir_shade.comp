@@ -1,0 +1,24 @@
+#version 460
+// ReSTIR PT pass 4: the pixel's estimate, the emission seen at the primary hit plus f(Y) W_Y,
+// added to the accumulation (the average of a static camera's frames). Non-finite estimates are
+// counted, not clamped.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "restir_bindings.glsl"
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    bool inside = p.x < width && p.y < height;
+    uint pixel = p.y * width + p.x;
+    if (inside) {
+        Reservoir r = load_reservoir(in_slot, pixel);
+        vec3 estimate = direct[pixel].rgb;
+        if (r.W > 0.0) estimate += r.record.contribution * r.W;
+        if (any(isnan(estimate)) || any(isinf(estimate))) local_nonfinite_pixels += 1u;
+        accum[pixel] += vec4(estimate, 1.0);
+        accum_sq[pixel].rgb += estimate * estimate;
+    }
+    report_pass_stats();
+}

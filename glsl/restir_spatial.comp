@@ -1,0 +1,42 @@
+#version 460
+// ReSTIR PT pass 3 (one round): spatial reuse from up to `neighbours` pixels drawn uniformly in
+// a disk of `radius` pixels; neighbours whose primary hit differs too much are skipped.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "restir_reuse.glsl"
+#include "sampling.glsl"
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    bool inside = p.x < width && p.y < height;
+    uint pixel = p.y * width + p.x;
+    if (inside) {
+        Reservoir canonical = load_reservoir(in_slot, pixel);
+        Reservoir result = canonical;
+        Surface surface = load_surface(surface_slot, pixel);
+        if (surface.triangle != NO_HIT) {
+            uint seed = path_seed(pixel, frame_index, render_seed ^ pass_seed);
+            inputs[0] = ReuseInput(canonical, surface.camera, surface_vertex(surface), canonical.M);
+            uint n = 1u;
+            for (uint j = 0u; j < min(neighbours, MAX_INPUTS - 1u); ++j) {
+                loop_tick();
+                vec4 u = rng_uniform4(seed, MAX_INPUTS + j, STREAM_RESAMPLE);
+                float r = radius * sqrt(u.x);
+                float phi = 2.0 * PI * u.y;
+                ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(phi), sin(phi))));
+                if (q.x < 0 || q.y < 0 || q.x >= int(width) || q.y >= int(height) || all(equal(uvec2(q), p))) continue;
+                uint neighbour = uint(q.y) * width + uint(q.x);
+                Surface other = load_surface(surface_slot, neighbour);
+                if (!similar_surfaces(surface, other)) continue;
+                Reservoir res = load_reservoir(in_slot, neighbour);
+                inputs[n] = ReuseInput(res, other.camera, surface_vertex(other), res.M);
+                n += 1u;
+            }
+            result = resample_inputs(n, seed);
+        }
+        store_reservoir(out_slot, pixel, result);
+    }
+    report_pass_stats();
+}

@@ -1,0 +1,46 @@
+#version 460
+// ReSTIR PT pass 2: temporal reuse. The pixel's primary hit is reprojected into the previous
+// frame's camera; that pixel's final reservoir is shifted into this pixel's domain and resampled
+// with this pixel's initial reservoir, its confidence capped at m_cap times the current M.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "restir_reuse.glsl"
+
+// The previous frame's pixel that saw `pos`, if any.
+bool reproject(vec3 pos, out uint pixel) {
+    vec3 d = pos - prev_cam_position.xyz;
+    float z = dot(d, prev_cam_forward.xyz);
+    if (!(z > 0.0)) return false;
+    float x = dot(d, prev_cam_right.xyz) / (z * prev_cam_position.w * prev_cam_right.w);
+    float y = dot(d, prev_cam_up.xyz) / (z * prev_cam_position.w);
+    vec2 image = vec2((x + 1.0) * 0.5 * float(width), (1.0 - y) * 0.5 * float(height));
+    if (!(image.x >= 0.0 && image.y >= 0.0 && image.x < float(width) && image.y < float(height))) return false;
+    pixel = uint(image.y) * width + uint(image.x);
+    return true;
+}
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    bool inside = p.x < width && p.y < height;
+    uint pixel = p.y * width + p.x;
+    if (inside) {
+        Reservoir canonical = load_reservoir(in_slot, pixel);
+        Reservoir result = canonical;
+        Surface surface = load_surface(surface_slot, pixel);
+        uint prev_pixel;
+        if (temporal_valid != 0u && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
+            Surface prev_surface = load_surface(1u - surface_slot, prev_pixel);
+            if (similar_surfaces(surface, prev_surface)) {
+                inputs[0] = ReuseInput(canonical, surface.camera, surface_vertex(surface), canonical.M);
+                Reservoir prev = load_reservoir(prev_slot, prev_pixel);
+                float confidence = min(prev.M, m_cap * canonical.M);
+                inputs[1] = ReuseInput(prev, prev_surface.camera, surface_vertex(prev_surface), confidence);
+                result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed));
+            }
+        }
+        store_reservoir(out_slot, pixel, result);
+    }
+    report_pass_stats();
+}

@@ -1,0 +1,140 @@
+//! What a ReSTIR PT render is asked to do on top of the path tracer's settings.
+
+use anyhow::{bail, Result};
+
+use crate::path_record::MAX_PATH_LENGTH;
+
+/// The shift mapping used for reuse (and, inverted, for its MIS weights).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShiftKind {
+    Reconnection,
+    Replay,
+    Hybrid,
+}
+
+/// The resampling MIS weights of reuse.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReuseMis {
+    /// Generalized balance heuristic with confidence weights, O(M^2) inverse shifts.
+    GeneralizedBalance,
+    /// Defensive pairwise MIS, O(M).
+    Pairwise,
+}
+
+impl ShiftKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ShiftKind::Reconnection => "reconnection",
+            ShiftKind::Replay => "replay",
+            ShiftKind::Hybrid => "hybrid",
+        }
+    }
+
+    /// The SHIFT_MODE value of glsl/restir_reuse.glsl.
+    fn define(self) -> &'static str {
+        match self {
+            ShiftKind::Reconnection => "0",
+            ShiftKind::Replay => "1",
+            ShiftKind::Hybrid => "2",
+        }
+    }
+}
+
+impl ReuseMis {
+    pub fn name(self) -> &'static str {
+        match self {
+            ReuseMis::GeneralizedBalance => "gbh",
+            ReuseMis::Pairwise => "pairwise",
+        }
+    }
+
+    /// The MIS_MODE value of glsl/restir_reuse.glsl.
+    fn define(self) -> &'static str {
+        match self {
+            ReuseMis::GeneralizedBalance => "0",
+            ReuseMis::Pairwise => "1",
+        }
+    }
+}
+
+/// Most spatial neighbours per round (glsl/restir_reuse.glsl's MAX_INPUTS - 1).
+pub const MAX_NEIGHBOURS: u32 = 8;
+pub const MAX_ROUNDS: u32 = 3;
+pub const MAX_CANDIDATES: u32 = 64;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct RestirSettings {
+    pub shift: ShiftKind,
+    pub mis: ReuseMis,
+    pub temporal: bool,
+    /// Spatial neighbours per round; 0 turns spatial reuse off.
+    pub spatial: u32,
+    pub radius: f32,
+    pub rounds: u32,
+    /// The temporal input's confidence is capped at m_cap times the current M.
+    pub m_cap: f32,
+    /// Initial paths per pixel.
+    pub candidates: u32,
+    pub normal_threshold: f32,
+    pub depth_threshold: f32,
+}
+
+impl Default for RestirSettings {
+    fn default() -> Self {
+        Self {
+            shift: ShiftKind::Hybrid,
+            mis: ReuseMis::GeneralizedBalance,
+            temporal: true,
+            spatial: 3,
+            radius: 20.0,
+            rounds: 1,
+            m_cap: 20.0,
+            candidates: 1,
+            normal_threshold: 0.9,
+            depth_threshold: 0.1,
+        }
+    }
+}
+
+impl RestirSettings {
+    pub fn validate(&self, max_depth: u32) -> Result<()> {
+        if max_depth as usize > MAX_PATH_LENGTH {
+            bail!("--max-depth {max_depth} is too deep for ReSTIR PT: its path records hold at most {MAX_PATH_LENGTH} segments");
+        }
+        if self.spatial > MAX_NEIGHBOURS {
+            bail!("--spatial {} is too many neighbours: at most {MAX_NEIGHBOURS}", self.spatial);
+        }
+        if self.spatial > 0 && !(1..=MAX_ROUNDS).contains(&self.rounds) {
+            bail!("--rounds {} is out of range: 1 to {MAX_ROUNDS} spatial rounds", self.rounds);
+        }
+        if !(self.radius.is_finite() && self.radius >= 1.0) {
+            bail!("--radius {} must be a finite number of pixels, at least 1", self.radius);
+        }
+        if !(self.m_cap.is_finite() && self.m_cap > 0.0) {
+            bail!("--m-cap {} must be finite and positive", self.m_cap);
+        }
+        if !(1..=MAX_CANDIDATES).contains(&self.candidates) {
+            bail!("--candidates {} is out of range: 1 to {MAX_CANDIDATES} paths per pixel", self.candidates);
+        }
+        Ok(())
+    }
+
+    /// The spatial rounds actually run.
+    pub fn spatial_rounds(&self) -> u32 {
+        if self.spatial == 0 {
+            0
+        } else {
+            self.rounds
+        }
+    }
+
+    /// The `#define`s that select the shift and the MIS in the reuse kernels.
+    pub fn defines(&self) -> [(&'static str, &'static str); 2] {
+        [("SHIFT_MODE", self.shift.define()), ("MIS_MODE", self.mis.define())]
+    }
+
+    /// A short label such as `restir:hybrid/gbh`.
+    pub fn label(&self) -> String {
+        format!("restir:{}/{}", self.shift.name(), self.mis.name())
+    }
+}
