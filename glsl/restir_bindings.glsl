@@ -48,7 +48,7 @@ layout(std430, set = 0, binding = 13) buffer Tails2 { ReservoirTail tails2[]; };
 layout(std430, set = 0, binding = 14) buffer Direct { vec4 direct[]; };     // rgb: emission seen at the primary hit
 layout(std430, set = 0, binding = 15) buffer Accum { vec4 accum[]; };       // rgb: sum of frames, w: count
 layout(std430, set = 0, binding = 16) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of squares
-layout(std430, set = 0, binding = 17) buffer Stats {
+layout(std430, set = 0, binding = 17) buffer RestirStats {
     uint max_loop_iterations;
     uint loop_budget_cut_groups;
     uint shifts_attempted;

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use restir_pt::cli::{self, DeviceArgs, RenderArgs};
+use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
+use restir_pt::render::{RestirSettings, ReuseMis, ShiftKind};
 
 #[derive(Parser)]
 #[command(
@@ -19,7 +20,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG.
+    /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG with ReSTIR PT (default)
+    /// or the path tracer.
     Render(RenderCmd),
     /// Print a scene's triangles, emitters, materials, bounds and cameras.
     Info { scene: PathBuf },
@@ -39,6 +41,29 @@ impl Toggle {
     }
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum MethodOpt {
+    /// Unidirectional path tracing with NEE and MIS.
+    Pt,
+    /// ReSTIR PT: resampled paths reused across pixels and frames through shift mappings.
+    Restir,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ShiftOpt {
+    Reconnection,
+    Replay,
+    Hybrid,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum MisOpt {
+    /// Generalized balance heuristic with confidence weights (O(M^2) shifts).
+    Gbh,
+    /// Defensive pairwise MIS (O(M) shifts).
+    Pairwise,
+}
+
 #[derive(Args)]
 struct DeviceOpts {
     /// Vulkan device to use: a name substring or an index (the chosen device is printed).
@@ -53,15 +78,18 @@ struct DeviceOpts {
 struct RenderCmd {
     /// glTF 2.0 scene (.gltf or .glb); defaults to the bundled Cornell box.
     scene: Option<PathBuf>,
-    #[arg(long, default_value_t = 64)]
-    spp: u32,
+    #[arg(long, value_enum, default_value_t = MethodOpt::Restir)]
+    method: MethodOpt,
+    /// Path-tracer samples per pixel (default 64); only with --method pt.
+    #[arg(long)]
+    spp: Option<u32>,
     #[arg(long, default_value_t = 256)]
     width: u32,
     #[arg(long, default_value_t = 256)]
     height: u32,
     /// Maximum number of path segments: 1 shows only directly visible emitters, 2 adds direct
-    /// lighting, each further step adds one bounce of indirect light.
-    #[arg(long, default_value_t = 8)]
+    /// lighting, each further step adds one bounce of indirect light (ReSTIR PT: at most 7).
+    #[arg(long, default_value_t = 7)]
     max_depth: u32,
     #[arg(long, default_value_t = 0)]
     seed: u32,
@@ -75,6 +103,33 @@ struct RenderCmd {
     /// The last frame goes to --out; every frame too with --out-dir.
     #[arg(long, default_value_t = 1)]
     frames: u32,
+    /// Render every frame from --camera and write the average of the frames (offline mode).
+    #[arg(long)]
+    static_camera: bool,
+    /// ReSTIR PT: the shift mapping used for reuse.
+    #[arg(long, value_enum, default_value_t = ShiftOpt::Hybrid)]
+    shift: ShiftOpt,
+    /// ReSTIR PT: resampling MIS weights.
+    #[arg(long, value_enum, default_value_t = MisOpt::Gbh)]
+    mis: MisOpt,
+    /// ReSTIR PT: reuse the previous frame's reservoirs.
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    temporal: Toggle,
+    /// ReSTIR PT: spatial neighbours per round (0 turns spatial reuse off; at most 8).
+    #[arg(long, default_value_t = 3)]
+    spatial: u32,
+    /// ReSTIR PT: spatial reuse radius in pixels.
+    #[arg(long, default_value_t = 20.0)]
+    radius: f32,
+    /// ReSTIR PT: spatial reuse rounds (1 to 3).
+    #[arg(long, default_value_t = 1)]
+    rounds: u32,
+    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M.
+    #[arg(long, default_value_t = 20.0)]
+    m_cap: f32,
+    /// ReSTIR PT: initial paths traced per pixel and frame.
+    #[arg(long, default_value_t = 1)]
+    candidates: u32,
     /// Folder for every frame of --frames (frame_0000.exr/png, ...).
     #[arg(long)]
     out_dir: Option<PathBuf>,
@@ -136,6 +191,28 @@ fn main() -> ExitCode {
     };
     let result = match command {
         Command::Render(r) => cli::render(RenderArgs {
+            method: match r.method {
+                MethodOpt::Pt => Method::PathTracing,
+                MethodOpt::Restir => Method::Restir(RestirSettings {
+                    shift: match r.shift {
+                        ShiftOpt::Reconnection => ShiftKind::Reconnection,
+                        ShiftOpt::Replay => ShiftKind::Replay,
+                        ShiftOpt::Hybrid => ShiftKind::Hybrid,
+                    },
+                    mis: match r.mis {
+                        MisOpt::Gbh => ReuseMis::GeneralizedBalance,
+                        MisOpt::Pairwise => ReuseMis::Pairwise,
+                    },
+                    temporal: r.temporal.on(),
+                    spatial: r.spatial,
+                    radius: r.radius,
+                    rounds: r.rounds,
+                    m_cap: r.m_cap,
+                    candidates: r.candidates,
+                    ..Default::default()
+                }),
+            },
+            static_camera: r.static_camera,
             scene: r.scene,
             spp: r.spp,
             width: r.width,

@@ -6,7 +6,7 @@ mod render;
 
 pub use bench::{bench, BenchArgs};
 pub use info::info;
-pub use render::{render, RenderArgs};
+pub use render::{render, Method, RenderArgs};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -1,4 +1,5 @@
-//! `restir-pt render`: progressive path tracing to EXR/PNG with a one-line summary.
+//! `restir-pt render`: ReSTIR PT frames or progressive path tracing to EXR/PNG, with a one-line
+//! summary per frame.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -9,11 +10,23 @@ use serde::Serialize;
 
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::image_io::{write_exr, write_png};
-use crate::render::{PathTracer, RenderSettings};
+use crate::render::{FrameStats, PathTracer, RenderSettings, Restir, RestirSettings, PASS_NAMES};
+use crate::scene::Scene;
+
+/// The rendering method: the path tracer, or ReSTIR PT with its settings.
+#[derive(Debug, Clone)]
+pub enum Method {
+    PathTracing,
+    Restir(RestirSettings),
+}
 
 pub struct RenderArgs {
     pub scene: Option<PathBuf>,
-    pub spp: u32,
+    pub method: Method,
+    /// Paths per pixel of the path tracer (default 64); ReSTIR PT renders frames instead.
+    pub spp: Option<u32>,
+    /// Every frame from --camera, averaged (ReSTIR PT's offline mode).
+    pub static_camera: bool,
     pub width: u32,
     pub height: u32,
     pub max_depth: u32,
@@ -33,6 +46,7 @@ pub struct RenderArgs {
 pub struct RenderReport {
     pub device: String,
     pub scene: String,
+    pub method: String,
     pub width: u32,
     pub height: u32,
     pub spp: u32,
@@ -40,13 +54,16 @@ pub struct RenderReport {
     pub gpu_ms: f64,
     pub wall_ms: f64,
     pub paths_per_second: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub restir: Option<RestirFrameReport>,
 }
 
 impl RenderReport {
     pub fn summary_line(&self) -> String {
         format!(
-            "{} | {}x{} | {} spp | depth {} | GPU {:.1} ms | wall {:.1} ms | {:.3} M paths/s",
+            "{} | {} | {}x{} | {} spp | depth {} | GPU {:.1} ms | wall {:.1} ms | {:.3} M paths/s",
             self.device,
+            self.method,
             self.width,
             self.height,
             self.spp,
@@ -88,38 +105,54 @@ fn create_parent(file: &Path) -> Result<()> {
     }
 }
 
+/// The scene camera of frame `frame`: --camera for a static camera, else the next camera of the
+/// scene's camera path for each frame.
+fn frame_camera(args: &RenderArgs, frame: u32) -> usize {
+    if args.static_camera {
+        args.camera
+    } else {
+        args.camera + frame as usize
+    }
+}
+
 pub fn render(args: RenderArgs) -> Result<()> {
     let path = scene_path(args.scene.as_deref());
     let scene = load_with_warnings(&path)?;
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let last_camera = args.camera + args.frames as usize - 1;
+    let last_camera = frame_camera(&args, args.frames - 1);
     if last_camera >= scene.cameras.len() {
         bail!(
-            "{}: --frames {} from --camera {} needs camera {last_camera}, but the scene has {} camera(s)",
+            "{}: --frames {} from --camera {} needs camera {last_camera}, but the scene has {} camera(s) (--static-camera renders every frame from one)",
             path.display(),
             args.frames,
             args.camera,
             scene.cameras.len()
         );
     }
+    if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
+        bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
+    }
     let settings = RenderSettings {
         width: args.width,
         height: args.height,
-        spp: args.spp,
+        spp: args.spp.unwrap_or(64),
         max_depth: args.max_depth,
         seed: args.seed,
         russian_roulette: args.russian_roulette,
         camera: args.camera,
     };
     settings.validate(&scene)?;
+    if let Method::Restir(restir) = &args.method {
+        restir.validate(settings.max_depth)?;
+    }
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "render".into());
-    let out = args.out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}.exr")));
-    let png = args.png.unwrap_or_else(|| out.with_extension("png"));
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}.exr")));
+    let png = args.png.clone().unwrap_or_else(|| out.with_extension("png"));
     for file in [Some(&out), Some(&png), args.variance.as_ref(), args.report.as_ref()]
         .into_iter()
         .flatten()
@@ -131,14 +164,74 @@ pub fn render(args: RenderArgs) -> Result<()> {
     }
 
     let ctx = open_device(&args.device)?;
+    let outputs = Outputs {
+        out: &out,
+        png: &png,
+        variance: args.variance.as_deref(),
+        out_dir: args.out_dir.as_deref(),
+    };
+    let report = match &args.method {
+        Method::PathTracing => render_path_traced(&ctx, &scene, &path, &args, &settings, &outputs)?,
+        Method::Restir(restir) => render_restir(&ctx, &scene, &path, &args, &settings, restir, &outputs)?,
+    };
+    finish_device(&ctx)?;
+    if let (Some(r), Some(report)) = (&args.report, &report) {
+        std::fs::write(r, serde_json::to_string_pretty(report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
+    }
+    eprintln!("wrote {} and {}", out.display(), png.display());
+    Ok(())
+}
+
+struct Outputs<'a> {
+    out: &'a Path,
+    png: &'a Path,
+    variance: Option<&'a Path>,
+    out_dir: Option<&'a Path>,
+}
+
+impl Outputs<'_> {
+    fn write_frame(&self, frame: u32, image: &crate::render::Image) -> Result<()> {
+        if let Some(dir) = self.out_dir {
+            let name = format!("frame_{frame:04}");
+            write_exr(&dir.join(format!("{name}.exr")), image.width, image.height, &image.mean)?;
+            write_png(&dir.join(format!("{name}.png")), image)?;
+        }
+        Ok(())
+    }
+
+    fn write_final(&self, image: &crate::render::Image) -> Result<()> {
+        write_exr(self.out, image.width, image.height, &image.mean)?;
+        write_png(self.png, image)?;
+        if let Some(v) = self.variance {
+            write_exr(v, image.width, image.height, &image.variance)?;
+        }
+        Ok(())
+    }
+}
+
+fn frame_prefix(args: &RenderArgs, frame: u32) -> String {
+    if args.frames > 1 {
+        format!("frame {frame} | ")
+    } else {
+        String::new()
+    }
+}
+
+fn render_path_traced(
+    ctx: &Arc<crate::vk::Context>,
+    scene: &Scene,
+    path: &Path,
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    outputs: &Outputs,
+) -> Result<Option<RenderReport>> {
     let interrupt = interrupt_flag();
-    let mut report = None;
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
+    let mut tracer = PathTracer::new(ctx, scene, settings)?;
     for frame in 0..args.frames {
         if frame > 0 {
-            let camera = args.camera + frame as usize;
+            let camera = frame_camera(args, frame);
             tracer.restart(
-                &scene,
+                scene,
                 &RenderSettings {
                     camera,
                     ..settings.clone()
@@ -149,14 +242,11 @@ pub fn render(args: RenderArgs) -> Result<()> {
         let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
         bar.finish_and_clear();
         let image = tracer.image()?;
-        if let Some(dir) = &args.out_dir {
-            let name = format!("frame_{frame:04}");
-            write_exr(&dir.join(format!("{name}.exr")), image.width, image.height, &image.mean)?;
-            write_png(&dir.join(format!("{name}.png")), &image)?;
-        }
+        outputs.write_frame(frame, &image)?;
         let frame_report = RenderReport {
             device: ctx.info.name.clone(),
             scene: path.display().to_string(),
+            method: "pt".into(),
             width: settings.width,
             height: settings.height,
             spp: stats.spp,
@@ -164,35 +254,111 @@ pub fn render(args: RenderArgs) -> Result<()> {
             gpu_ms: stats.gpu_ms,
             wall_ms: stats.wall_ms,
             paths_per_second: stats.paths_per_second(settings.pixel_count()),
+            restir: None,
         };
-        println!(
-            "{}{}",
-            if args.frames > 1 {
-                format!("frame {frame} | ")
-            } else {
-                String::new()
-            },
-            frame_report.summary_line()
-        );
-        let last = frame + 1 == args.frames || stats.interrupted;
+        println!("{}{}", frame_prefix(args, frame), frame_report.summary_line());
         if stats.interrupted {
             eprintln!("interrupted: writing the {} spp of frame {frame} accumulated so far", stats.spp);
         }
-        if last {
-            write_exr(&out, image.width, image.height, &image.mean)?;
-            write_png(&png, &image)?;
-            if let Some(v) = &args.variance {
-                write_exr(v, image.width, image.height, &image.variance)?;
-            }
+        if frame + 1 == args.frames || stats.interrupted {
+            outputs.write_final(&image)?;
+            return Ok(Some(frame_report));
+        }
+    }
+    Ok(None)
+}
+
+/// What a ReSTIR PT frame reports beyond the common summary.
+#[derive(Serialize, Clone)]
+pub struct RestirFrameReport {
+    pub frames: u32,
+    pub pass_ms: Vec<(String, f64)>,
+    pub shifts_attempted: u32,
+    pub shifts_failed: u32,
+    pub failed_shift_rate: f64,
+    pub nonfinite_weights: u32,
+    pub nonfinite_pixels: u32,
+    pub candidates_dropped: u32,
+}
+
+impl RestirFrameReport {
+    fn from_stats(frames: u32, stats: &FrameStats) -> Self {
+        let c = &stats.counters;
+        RestirFrameReport {
+            frames,
+            pass_ms: match stats.pass_ms {
+                Some(ms) => PASS_NAMES.iter().zip(ms).map(|(n, t)| (n.to_string(), t)).collect(),
+                None => vec![],
+            },
+            shifts_attempted: c.shifts_attempted,
+            shifts_failed: c.shifts_failed,
+            failed_shift_rate: stats.failed_shift_rate(),
+            nonfinite_weights: c.nonfinite_weights,
+            nonfinite_pixels: c.nonfinite_pixels,
+            candidates_dropped: c.candidates_dropped,
+        }
+    }
+
+    fn summary(&self) -> String {
+        let passes: Vec<String> = self.pass_ms.iter().map(|(n, t)| format!("{n} {t:.1}")).collect();
+        format!(
+            "passes ms: {} | failed shifts {}/{} ({:.1}%) | non-finite weights {} | non-finite pixels {}",
+            if passes.is_empty() { "n/a".to_string() } else { passes.join(", ") },
+            self.shifts_failed,
+            self.shifts_attempted,
+            100.0 * self.failed_shift_rate,
+            self.nonfinite_weights,
+            self.nonfinite_pixels
+        )
+    }
+}
+
+fn render_restir(
+    ctx: &Arc<crate::vk::Context>,
+    scene: &Scene,
+    path: &Path,
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    restir: &RestirSettings,
+    outputs: &Outputs,
+) -> Result<Option<RenderReport>> {
+    let interrupt = interrupt_flag();
+    let mut renderer = Restir::new(ctx, scene, settings, restir)?;
+    let mut gpu_ms = 0.0;
+    let mut report = None;
+    for frame in 0..args.frames {
+        let stats = renderer.frame(scene, frame_camera(args, frame), args.static_camera)?;
+        let image = renderer.image()?;
+        outputs.write_frame(frame, &image)?;
+        let frame_ms = stats.gpu_ms();
+        gpu_ms += frame_ms.unwrap_or(stats.wall_ms);
+        let detail = RestirFrameReport::from_stats(frame + 1, &stats);
+        let frame_report = RenderReport {
+            device: ctx.info.name.clone(),
+            scene: path.display().to_string(),
+            method: restir.label(),
+            width: settings.width,
+            height: settings.height,
+            spp: restir.candidates,
+            max_depth: settings.max_depth,
+            gpu_ms: frame_ms.unwrap_or(stats.wall_ms),
+            wall_ms: stats.wall_ms,
+            paths_per_second: settings.pixel_count() as f64 * restir.candidates as f64 / (frame_ms.unwrap_or(stats.wall_ms) * 1e-3),
+            restir: Some(detail.clone()),
+        };
+        println!("{}{} | {}", frame_prefix(args, frame), frame_report.summary_line(), detail.summary());
+        let interrupted = interrupt.load(Ordering::Relaxed);
+        if interrupted {
+            eprintln!("interrupted: writing frame {frame}");
+        }
+        if frame + 1 == args.frames || interrupted {
+            outputs.write_final(&image)?;
             report = Some(frame_report);
             break;
         }
     }
-    drop(tracer);
-    finish_device(&ctx)?;
-    if let (Some(r), Some(report)) = (&args.report, &report) {
-        std::fs::write(r, serde_json::to_string_pretty(report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
+    if args.frames > 1 {
+        eprintln!("{} frames, {gpu_ms:.1} ms of GPU time in all", args.frames);
     }
-    eprintln!("wrote {} and {}", out.display(), png.display());
-    Ok(())
+    Ok(report)
 }

@@ -4,7 +4,9 @@
 
 use std::collections::HashMap;
 
-use restir_pt::gpu_types::{BvhNode, Emitter, FrameParams, Material, Triangle};
+use restir_pt::gpu_types::{
+    BvhNode, Emitter, FrameParams, Material, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface, Triangle,
+};
 use restir_pt::path_record::PathRecord;
 use restir_pt::vk::compile_kernel;
 
@@ -128,4 +130,21 @@ fn path_record_matches_glsl_layout() {
         rc_pdf_after, contribution, rc_next_triangle),
     ];
     assert_eq!(check_layout("oracle/shift_oracle.comp", &[], record), 1);
+}
+
+#[test]
+fn restir_structs_match_glsl_layout() {
+    let structs = vec![
+        rust_fields!(ReuseParams: prev_cam_position, prev_cam_right, prev_cam_up, prev_cam_forward, roughness_threshold,
+            distance_threshold, m_cap, radius, normal_threshold, depth_threshold, frame_index, candidates, neighbours,
+            temporal_valid, pad0, pad1),
+        rust_fields!(Surface: pos, triangle, camera, depth),
+        rust_fields!(ReservoirHead: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry),
+        rust_fields!(ReservoirTail: suffix, rc_pdf_after, contribution, rc_next_triangle, weight, confidence, pad0, pad1),
+        rust_fields!(RestirStats: max_loop_iterations, loop_budget_cut_groups, shifts_attempted, shifts_failed, nonfinite_weights,
+            candidates_dropped, nonfinite_pixels, stats_pad),
+        rust_fields!(RestirPass: in_slot, out_slot, prev_slot, surface_slot, pass_seed),
+    ];
+    assert_eq!(check_layout("restir_spatial.comp", &[], structs), 6);
+    assert_eq!(std::mem::size_of::<ReservoirHead>() + std::mem::size_of::<ReservoirTail>(), 96);
 }
