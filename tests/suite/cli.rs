@@ -40,6 +40,8 @@ fn cli_render_writes_images_summary_and_report() {
         "32",
         "--height",
         "24",
+        "--method",
+        "pt",
         "--spp",
         "4",
         "--validate",
@@ -96,7 +98,7 @@ fn cli_bad_input_fails_with_one_clear_line() {
     assert_clean_failure(&["info", truncated.to_str().unwrap()], &["truncated.glb"]);
     assert_clean_failure(&["render", "--width", "0"], &["resolution 0x256"]);
     assert_clean_failure(&["render", "--width", "100000", "--height", "100000"], &["too large"]);
-    assert_clean_failure(&["render", "--spp", "0"], &["--spp"]);
+    assert_clean_failure(&["render", "--method", "pt", "--spp", "0"], &["--spp"]);
     assert_clean_failure(&["render", "--max-depth", "0"], &["--max-depth"]);
     assert_clean_failure(&["render", "--camera", "99"], &["--camera 99"]);
     assert_clean_failure(
@@ -115,6 +117,8 @@ fn cli_max_depth_one_shows_only_emitters() {
         "32",
         "--height",
         "32",
+        "--method",
+        "pt",
         "--spp",
         "2",
         "--max-depth",
@@ -149,6 +153,8 @@ fn cli_frames_render_along_the_camera_path() {
         "16",
         "--height",
         "16",
+        "--method",
+        "pt",
         "--spp",
         "2",
         "--validate",
@@ -182,6 +188,8 @@ fn cli_device_by_index_is_chosen_and_printed() {
         "8",
         "--height",
         "8",
+        "--method",
+        "pt",
         "--spp",
         "1",
         "--out",
@@ -189,4 +197,44 @@ fn cli_device_by_index_is_chosen_and_printed() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     assert!(stderr.lines().any(|l| l.starts_with("device: ")), "{stderr}");
+}
+
+#[test]
+fn cli_restir_render_prints_passes_and_failed_shifts() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let (exr, report) = (dir.join("restir.exr"), dir.join("restir.json"));
+    let (code, stdout, stderr) = restir_pt(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--frames",
+        "2",
+        "--shift",
+        "reconnection",
+        "--mis",
+        "pairwise",
+        "--spatial",
+        "2",
+        "--validate",
+        "--out",
+        exr.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let last = stdout.lines().find(|l| l.starts_with("frame 1 | ")).expect("a line per frame");
+    for needle in ["restir:reconnection/pairwise", "initial", "temporal", "spatial", "shade", "failed shifts", "non-finite pixels 0"] {
+        assert!(last.contains(needle), "{needle} missing: {last}");
+    }
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["method"], "restir:reconnection/pairwise");
+    assert!(json["restir"]["shifts_attempted"].as_u64().unwrap() > 0, "{json}");
+    assert!(exr.exists());
+    assert_clean_failure(&["render", "--spp", "4"], &["--spp", "ReSTIR"]);
+    assert_clean_failure(&["render", "--max-depth", "8"], &["--max-depth 8", "at most 7"]);
+    assert_clean_failure(&["render", "--spatial", "9"], &["--spatial 9"]);
+    assert_clean_failure(&["render", "--rounds", "4"], &["--rounds 4"]);
+    assert_clean_failure(&["render", "--m-cap", "NaN"], &["--m-cap"]);
 }

@@ -67,6 +67,8 @@ fn robustness_bad_input_corpus_gives_clear_errors_or_warnings() {
                 "16",
                 "--height",
                 "16",
+                "--method",
+                "pt",
                 "--spp",
                 "1",
                 "--out",
@@ -229,6 +231,8 @@ fn robustness_ctrl_c_writes_the_partial_image() {
     let child = Command::new(BIN)
         .args([
             "render",
+            "--method",
+            "pt",
             "--spp",
             "100000",
             "--width",
