@@ -27,6 +27,10 @@ enum Command {
     Info { scene: PathBuf },
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
     Bench(BenchCmd),
+    /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
+    Reference(ReferenceCmd),
+    /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
+    Profile(ProfileCmd),
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -62,6 +66,57 @@ enum MisOpt {
     Gbh,
     /// Defensive pairwise MIS (O(M) shifts).
     Pairwise,
+}
+
+#[derive(Args)]
+struct RestirOpts {
+    /// ReSTIR PT: the shift mapping used for reuse.
+    #[arg(long, value_enum, default_value_t = ShiftOpt::Hybrid)]
+    shift: ShiftOpt,
+    /// ReSTIR PT: resampling MIS weights.
+    #[arg(long, value_enum, default_value_t = MisOpt::Gbh)]
+    mis: MisOpt,
+    /// ReSTIR PT: reuse the previous frame's reservoirs.
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    temporal: Toggle,
+    /// ReSTIR PT: spatial neighbours per round (0 turns spatial reuse off; at most 8).
+    #[arg(long, default_value_t = 3)]
+    spatial: u32,
+    /// ReSTIR PT: spatial reuse radius in pixels.
+    #[arg(long, default_value_t = 20.0)]
+    radius: f32,
+    /// ReSTIR PT: spatial reuse rounds (1 to 3).
+    #[arg(long, default_value_t = 1)]
+    rounds: u32,
+    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M.
+    #[arg(long, default_value_t = 20.0)]
+    m_cap: f32,
+    /// ReSTIR PT: initial paths traced per pixel and frame.
+    #[arg(long, default_value_t = 1)]
+    candidates: u32,
+}
+
+impl RestirOpts {
+    fn settings(&self) -> RestirSettings {
+        RestirSettings {
+            shift: match self.shift {
+                ShiftOpt::Reconnection => ShiftKind::Reconnection,
+                ShiftOpt::Replay => ShiftKind::Replay,
+                ShiftOpt::Hybrid => ShiftKind::Hybrid,
+            },
+            mis: match self.mis {
+                MisOpt::Gbh => ReuseMis::GeneralizedBalance,
+                MisOpt::Pairwise => ReuseMis::Pairwise,
+            },
+            temporal: self.temporal.on(),
+            spatial: self.spatial,
+            radius: self.radius,
+            rounds: self.rounds,
+            m_cap: self.m_cap,
+            candidates: self.candidates,
+            ..Default::default()
+        }
+    }
 }
 
 #[derive(Args)]
@@ -106,30 +161,8 @@ struct RenderCmd {
     /// Render every frame from --camera and write the average of the frames (offline mode).
     #[arg(long)]
     static_camera: bool,
-    /// ReSTIR PT: the shift mapping used for reuse.
-    #[arg(long, value_enum, default_value_t = ShiftOpt::Hybrid)]
-    shift: ShiftOpt,
-    /// ReSTIR PT: resampling MIS weights.
-    #[arg(long, value_enum, default_value_t = MisOpt::Gbh)]
-    mis: MisOpt,
-    /// ReSTIR PT: reuse the previous frame's reservoirs.
-    #[arg(long, value_enum, default_value_t = Toggle::On)]
-    temporal: Toggle,
-    /// ReSTIR PT: spatial neighbours per round (0 turns spatial reuse off; at most 8).
-    #[arg(long, default_value_t = 3)]
-    spatial: u32,
-    /// ReSTIR PT: spatial reuse radius in pixels.
-    #[arg(long, default_value_t = 20.0)]
-    radius: f32,
-    /// ReSTIR PT: spatial reuse rounds (1 to 3).
-    #[arg(long, default_value_t = 1)]
-    rounds: u32,
-    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M.
-    #[arg(long, default_value_t = 20.0)]
-    m_cap: f32,
-    /// ReSTIR PT: initial paths traced per pixel and frame.
-    #[arg(long, default_value_t = 1)]
-    candidates: u32,
+    #[command(flatten)]
+    restir: RestirOpts,
     /// Folder for every frame of --frames (frame_0000.exr/png, ...).
     #[arg(long)]
     out_dir: Option<PathBuf>,
@@ -172,6 +205,51 @@ struct BenchCmd {
     device: DeviceOpts,
 }
 
+#[derive(Args)]
+struct ReferenceCmd {
+    scene: PathBuf,
+    #[arg(long, default_value_t = 4096)]
+    spp: u32,
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    #[arg(long, default_value_t = 7)]
+    max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    camera: usize,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct ProfileCmd {
+    scene: Option<PathBuf>,
+    /// Frames to time after two warm-up frames (static camera).
+    #[arg(long, default_value_t = 16)]
+    frames: u32,
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    #[arg(long, default_value_t = 7)]
+    max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    camera: usize,
+    #[command(flatten)]
+    restir: RestirOpts,
+    /// Folder for passes.csv, trace.json and passes.svg.
+    #[arg(long, default_value = "out/profile")]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    device: DeviceOpts,
+}
+
 impl From<DeviceOpts> for DeviceArgs {
     fn from(d: DeviceOpts) -> Self {
         DeviceArgs {
@@ -193,24 +271,7 @@ fn main() -> ExitCode {
         Command::Render(r) => cli::render(RenderArgs {
             method: match r.method {
                 MethodOpt::Pt => Method::PathTracing,
-                MethodOpt::Restir => Method::Restir(RestirSettings {
-                    shift: match r.shift {
-                        ShiftOpt::Reconnection => ShiftKind::Reconnection,
-                        ShiftOpt::Replay => ShiftKind::Replay,
-                        ShiftOpt::Hybrid => ShiftKind::Hybrid,
-                    },
-                    mis: match r.mis {
-                        MisOpt::Gbh => ReuseMis::GeneralizedBalance,
-                        MisOpt::Pairwise => ReuseMis::Pairwise,
-                    },
-                    temporal: r.temporal.on(),
-                    spatial: r.spatial,
-                    radius: r.radius,
-                    rounds: r.rounds,
-                    m_cap: r.m_cap,
-                    candidates: r.candidates,
-                    ..Default::default()
-                }),
+                MethodOpt::Restir => Method::Restir(r.restir.settings()),
             },
             static_camera: r.static_camera,
             scene: r.scene,
@@ -230,6 +291,28 @@ fn main() -> ExitCode {
             device: r.device.into(),
         }),
         Command::Info { scene } => cli::info(&scene),
+        Command::Reference(r) => cli::reference(cli::ReferenceArgs {
+            scene: r.scene,
+            spp: r.spp,
+            width: r.width,
+            height: r.height,
+            max_depth: r.max_depth,
+            camera: r.camera,
+            seed: r.seed,
+            out: r.out,
+            device: r.device.into(),
+        }),
+        Command::Profile(p) => cli::profile(cli::ProfileArgs {
+            restir: p.restir.settings(),
+            scene: p.scene,
+            frames: p.frames,
+            width: p.width,
+            height: p.height,
+            max_depth: p.max_depth,
+            camera: p.camera,
+            out_dir: p.out_dir,
+            device: p.device.into(),
+        }),
         Command::Bench(b) => cli::bench(cli::BenchArgs {
             scene: b.scene,
             width: b.width,

@@ -2,10 +2,14 @@
 
 mod bench;
 mod info;
+mod profile;
+mod reference;
 mod render;
 
 pub use bench::{bench, BenchArgs};
 pub use info::info;
+pub use profile::{profile, ProfileArgs};
+pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, Method, RenderArgs};
 
 use std::path::{Path, PathBuf};

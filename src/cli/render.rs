@@ -75,7 +75,7 @@ impl RenderReport {
     }
 }
 
-fn progress_bar(total: u32) -> indicatif::ProgressBar {
+pub(super) fn progress_bar(total: u32) -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(total as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})").expect("static template is valid"),
@@ -84,7 +84,7 @@ fn progress_bar(total: u32) -> indicatif::ProgressBar {
 }
 
 /// Installs a Ctrl-C handler once; later renders share the flag.
-fn interrupt_flag() -> Arc<AtomicBool> {
+pub(super) fn interrupt_flag() -> Arc<AtomicBool> {
     static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
     FLAG.get_or_init(|| {
         let flag = Arc::new(AtomicBool::new(false));
@@ -98,7 +98,7 @@ fn interrupt_flag() -> Arc<AtomicBool> {
     .clone()
 }
 
-fn create_parent(file: &Path) -> Result<()> {
+pub(super) fn create_parent(file: &Path) -> Result<()> {
     match file.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(dir) => std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display())),
         None => Ok(()),
@@ -346,7 +346,12 @@ fn render_restir(
             paths_per_second: settings.pixel_count() as f64 * restir.candidates as f64 / (frame_ms.unwrap_or(stats.wall_ms) * 1e-3),
             restir: Some(detail.clone()),
         };
-        println!("{}{} | {}", frame_prefix(args, frame), frame_report.summary_line(), detail.summary());
+        println!(
+            "{}{} | {}",
+            frame_prefix(args, frame),
+            frame_report.summary_line(),
+            detail.summary()
+        );
         let interrupted = interrupt.load(Ordering::Relaxed);
         if interrupted {
             eprintln!("interrupted: writing frame {frame}");

@@ -10,6 +10,6 @@ mod settings;
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir, PASS_NAMES};
-pub use restir_settings::{ReuseMis, RestirSettings, ShiftKind, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_ROUNDS};
+pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_ROUNDS};
 pub use scene_gpu::SceneGpu;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};

@@ -80,8 +80,18 @@ impl Restir {
         ctx.check_binding_size("the accumulation image", pixels * 16)?;
         let scene_gpu = SceneGpu::upload(ctx, scene)?;
         let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
-        let params = Buffer::new(ctx, "frame parameters", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Uniform)?;
-        let reuse = Buffer::new(ctx, "reuse parameters", std::mem::size_of::<ReuseParams>() as u64, BufferUsage::Uniform)?;
+        let params = Buffer::new(
+            ctx,
+            "frame parameters",
+            std::mem::size_of::<FrameParams>() as u64,
+            BufferUsage::Uniform,
+        )?;
+        let reuse = Buffer::new(
+            ctx,
+            "reuse parameters",
+            std::mem::size_of::<ReuseParams>() as u64,
+            BufferUsage::Uniform,
+        )?;
         let surfaces = [
             storage("surfaces 0", pixels * std::mem::size_of::<Surface>() as u64)?,
             storage("surfaces 1", pixels * std::mem::size_of::<Surface>() as u64)?,

@@ -114,7 +114,10 @@ impl RestirSettings {
             bail!("--m-cap {} must be finite and positive", self.m_cap);
         }
         if !(1..=MAX_CANDIDATES).contains(&self.candidates) {
-            bail!("--candidates {} is out of range: 1 to {MAX_CANDIDATES} paths per pixel", self.candidates);
+            bail!(
+                "--candidates {} is out of range: 1 to {MAX_CANDIDATES} paths per pixel",
+                self.candidates
+            );
         }
         Ok(())
     }

@@ -225,7 +225,15 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     let last = stdout.lines().find(|l| l.starts_with("frame 1 | ")).expect("a line per frame");
-    for needle in ["restir:reconnection/pairwise", "initial", "temporal", "spatial", "shade", "failed shifts", "non-finite pixels 0"] {
+    for needle in [
+        "restir:reconnection/pairwise",
+        "initial",
+        "temporal",
+        "spatial",
+        "shade",
+        "failed shifts",
+        "non-finite pixels 0",
+    ] {
         assert!(last.contains(needle), "{needle} missing: {last}");
     }
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
@@ -237,4 +245,45 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
     assert_clean_failure(&["render", "--spatial", "9"], &["--spatial 9"]);
     assert_clean_failure(&["render", "--rounds", "4"], &["--rounds 4"]);
     assert_clean_failure(&["render", "--m-cap", "NaN"], &["--m-cap"]);
+}
+
+#[test]
+fn cli_reference_and_profile_write_their_files() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().join("reference-profile");
+    let reference = dir.join("ref.exr");
+    let (code, _, stderr) = restir_pt(&[
+        "reference",
+        "scenes/cornell.gltf",
+        "--spp",
+        "8",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(reference.exists() && dir.join("ref.variance.exr").exists(), "{stderr}");
+
+    let (code, stdout, stderr) = restir_pt(&[
+        "profile",
+        "--frames",
+        "3",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let csv = std::fs::read_to_string(dir.join("passes.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 3 * 4, "{csv}");
+    let trace: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("trace.json")).unwrap()).unwrap();
+    assert_eq!(trace["traceEvents"].as_array().unwrap().len(), 12);
+    assert!(std::fs::read_to_string(dir.join("passes.svg")).unwrap().starts_with("<svg"));
+    for pass in ["initial", "temporal", "spatial", "shade", "frame"] {
+        assert!(stdout.lines().any(|l| l.starts_with(pass)), "{pass} median/p95 missing: {stdout}");
+    }
 }

@@ -196,7 +196,11 @@ fn check_unbiased(name: &str) {
                 100.0 * failed_rate
             );
             if (energy_ratio - 1.0).abs() > 0.01 || pass_rate < 0.99 {
-                failures.push(format!("{} (energy {energy_ratio:.4}, blocks {passed}/{})", restir.label(), ref_blocks.len()));
+                failures.push(format!(
+                    "{} (energy {energy_ratio:.4}, blocks {passed}/{})",
+                    restir.label(),
+                    ref_blocks.len()
+                ));
             }
         }
     }
@@ -227,7 +231,6 @@ fn restir_unbiased_veach_door() {
     check_unbiased("veach-door");
 }
 
-
 #[test]
 fn restir_same_seed_is_bit_identical() {
     let ctx = gpu();
@@ -243,7 +246,14 @@ fn restir_same_seed_is_bit_identical() {
         for camera in 0..FRAMES {
             renderer.frame(&scene, camera, false).unwrap();
         }
-        renderer.image().unwrap().mean.iter().flat_map(|v| v.to_array()).map(f32::to_bits).collect()
+        renderer
+            .image()
+            .unwrap()
+            .mean
+            .iter()
+            .flat_map(|v| v.to_array())
+            .map(f32::to_bits)
+            .collect()
     };
     let (first, again, other) = (chain(7), chain(7), chain(8));
     assert_eq!(first, again, "the same seed must give the same bits");

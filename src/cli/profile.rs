@@ -1,0 +1,163 @@
+//! `restir-pt profile`: per-pass GPU times of ReSTIR PT frames as CSV, as a Chrome trace
+//! (opens in Perfetto or chrome://tracing) and as a stacked-bar SVG, with the median and p95.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context as _, Result};
+
+use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use crate::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
+
+pub struct ProfileArgs {
+    pub scene: Option<PathBuf>,
+    pub frames: u32,
+    pub width: u32,
+    pub height: u32,
+    pub max_depth: u32,
+    pub camera: usize,
+    pub restir: RestirSettings,
+    pub out_dir: PathBuf,
+    pub device: DeviceArgs,
+}
+
+/// The q-quantile (0..=1) of `values` by the nearest-rank method.
+fn quantile(values: &[f64], q: f64) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
+}
+
+const PASS_COLOURS: [&str; 4] = ["#4c72b0", "#dd8452", "#55a868", "#c44e52"];
+
+/// A stacked bar per frame, one colour per pass.
+fn stacked_bar_svg(times: &[[f64; 4]], title: &str) -> String {
+    let (w, h, left, bottom, top) = (720.0, 360.0, 60.0, 40.0, 40.0);
+    let max = times.iter().map(|t| t.iter().sum::<f64>()).fold(0.0, f64::max).max(1e-9);
+    let bar = (w - left - 20.0) / times.len() as f64;
+    let scale = (h - bottom - top) / max;
+    let mut svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
+         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{left}\" y=\"20\">{title}</text>\n"
+    );
+    for (f, t) in times.iter().enumerate() {
+        let mut y = h - bottom;
+        for (p, ms) in t.iter().enumerate() {
+            let height = ms * scale;
+            y -= height;
+            let x = left + f as f64 * bar;
+            let _ = writeln!(
+                svg,
+                "<rect x=\"{x:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{height:.1}\" fill=\"{}\"><title>frame {f} {}: {ms:.2} ms</title></rect>",
+                (bar * 0.8).max(1.0),
+                PASS_COLOURS[p],
+                PASS_NAMES[p]
+            );
+        }
+    }
+    let _ = writeln!(
+        svg,
+        "<line x1=\"{left}\" y1=\"{0}\" x2=\"{1}\" y2=\"{0}\" stroke=\"black\"/><text x=\"{left}\" y=\"{2}\">frames 0..{3}</text>",
+        h - bottom,
+        w - 20.0,
+        h - 12.0,
+        times.len()
+    );
+    let _ = writeln!(svg, "<text x=\"4\" y=\"{}\">{max:.1} ms</text>", top + 4.0);
+    for (p, name) in PASS_NAMES.iter().enumerate() {
+        let x = w - 360.0 + p as f64 * 85.0;
+        let _ = writeln!(
+            svg,
+            "<rect x=\"{x}\" y=\"8\" width=\"12\" height=\"12\" fill=\"{}\"/><text x=\"{}\" y=\"19\">{name}</text>",
+            PASS_COLOURS[p],
+            x + 16.0
+        );
+    }
+    svg.push_str("</svg>\n");
+    svg
+}
+
+/// Chrome trace events: frames one after another, passes one after another within a frame.
+fn chrome_trace(times: &[[f64; 4]]) -> serde_json::Value {
+    let mut events = vec![];
+    let mut clock_us = 0.0;
+    for (f, t) in times.iter().enumerate() {
+        for (p, ms) in t.iter().enumerate() {
+            events.push(serde_json::json!({
+                "name": PASS_NAMES[p], "cat": "gpu", "ph": "X", "pid": 1, "tid": 1,
+                "ts": clock_us, "dur": ms * 1e3, "args": { "frame": f }
+            }));
+            clock_us += ms * 1e3;
+        }
+    }
+    serde_json::json!({ "traceEvents": events, "displayTimeUnit": "ms" })
+}
+
+fn write(path: &Path, contents: &str) -> Result<()> {
+    std::fs::write(path, contents).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+pub fn profile(args: ProfileArgs) -> Result<()> {
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let path = scene_path(args.scene.as_deref());
+    let scene = load_with_warnings(&path)?;
+    let settings = RenderSettings {
+        width: args.width,
+        height: args.height,
+        max_depth: args.max_depth,
+        camera: args.camera,
+        ..Default::default()
+    };
+    settings.validate(&scene)?;
+    args.restir.validate(settings.max_depth)?;
+    std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
+    let ctx = open_device(&args.device)?;
+    if !ctx.info.timestamps_supported {
+        bail!("{}: the device has no compute timestamps to profile with", ctx.info.name);
+    }
+    let mut renderer = Restir::new(&ctx, &scene, &settings, &args.restir)?;
+    // llvmpipe compiles a pipeline at its first dispatch: two unrecorded warm-up frames (the
+    // first has no temporal pass).
+    for _ in 0..2 {
+        renderer.frame(&scene, args.camera, true)?;
+    }
+    renderer.reset(settings.seed)?;
+    let mut times = vec![];
+    for _ in 0..args.frames {
+        let stats = renderer.frame(&scene, args.camera, true)?;
+        times.push(stats.pass_ms.expect("timestamps are supported"));
+    }
+    drop(renderer);
+    finish_device(&ctx)?;
+
+    let mut csv = String::from("frame,pass,gpu_ms\n");
+    for (f, t) in times.iter().enumerate() {
+        for (p, ms) in t.iter().enumerate() {
+            let _ = writeln!(csv, "{f},{},{ms:.4}", PASS_NAMES[p]);
+        }
+    }
+    let title = format!(
+        "{} {} {}x{} on {}",
+        path.display(),
+        args.restir.label(),
+        args.width,
+        args.height,
+        ctx.info.name
+    );
+    write(&args.out_dir.join("passes.csv"), &csv)?;
+    write(&args.out_dir.join("trace.json"), &serde_json::to_string(&chrome_trace(&times))?)?;
+    write(&args.out_dir.join("passes.svg"), &stacked_bar_svg(&times, &title))?;
+    println!("{title}, {} frames: GPU ms per pass", args.frames);
+    println!("{:<10} {:>10} {:>10}", "pass", "median", "p95");
+    for (p, name) in PASS_NAMES.iter().enumerate() {
+        let v: Vec<f64> = times.iter().map(|t| t[p]).collect();
+        println!("{name:<10} {:>10.2} {:>10.2}", quantile(&v, 0.5), quantile(&v, 0.95));
+    }
+    let total: Vec<f64> = times.iter().map(|t| t.iter().sum()).collect();
+    println!("{:<10} {:>10.2} {:>10.2}", "frame", quantile(&total, 0.5), quantile(&total, 0.95));
+    eprintln!("wrote passes.csv, trace.json and passes.svg in {}", args.out_dir.display());
+    Ok(())
+}
