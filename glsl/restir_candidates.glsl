@@ -3,7 +3,8 @@
 // lobe. These two end types partition the paths (NEE cannot reach past a delta lobe, and a BSDF
 // hit after a non-delta lobe is left to NEE), so each path has exactly one way to be offered and
 // needs no further MIS weight; the shifts keep the lobe before the end, hence the partition.
-// The paths are built exactly as generate_path() in shift.glsl regenerates them from the seed.
+// The paths are built with the steps generate_path() in shift.glsl regenerates them with
+// (nee_vertex, bsdf_vertex).
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
 
@@ -48,9 +49,9 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         Material m = material_of(x);
         vec4 u = rng_uniform4(seed, i, STREAM_RESAMPLE);
 
-        LightSample ls = sample_light(x.pos, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
-        if (ls.pdf > 0.0) {
-            Vertex light = ls.triangle == NO_EMITTER ? vertex_escaped(ls.dir) : vertex_on_surface(ls.triangle, x.pos + ls.dir * ls.dist);
+        LightSample ls;
+        Vertex light;
+        if (nee_vertex(x, seed, i, ls, light)) {
             float bsdf_pdf;
             vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
             if (max_component(f_cos) > 0.0 && visible(x, light)) {
@@ -65,11 +66,9 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
             }
         }
 
-        BsdfSample b = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
-        if (b.lobe == LOBE_NONE) break;
-        vec3 side = dot(b.wi, x.normal) > 0.0 ? x.normal : -x.normal;
-        Hit hit = trace_closest(offset_ray_origin(x.pos, side), b.wi, SHIFT_RAY_TMAX);
-        Vertex next = hit.triangle == NO_HIT ? vertex_escaped(b.wi) : hit_vertex(hit);
+        BsdfSample b;
+        Vertex next;
+        if (!bsdf_vertex(x, wo, m, seed, i, b, next)) break;
         p.lobes[i - 1u] = b.lobe;
         p.weights[i - 1u] = b.weight;
         p.vertices[i] = next;

@@ -114,6 +114,26 @@ Vertex hit_vertex(Hit hit) {
     return vertex_on_surface(hit.triangle, t.v0 + hit.bary.x * t.e1 + hit.bary.y * t.e2);
 }
 
+// The light point NEE at x_i chooses with the path's random numbers; false if none can be chosen.
+// Visibility is left to the caller.
+bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex light) {
+    ls = sample_light(x.pos, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
+    if (!(ls.pdf > 0.0)) return false;
+    light = ls.triangle == NO_EMITTER ? vertex_escaped(ls.dir) : vertex_on_surface(ls.triangle, x.pos + ls.dir * ls.dist);
+    return true;
+}
+
+// The vertex BSDF sampling at x_i reaches with the path's random numbers; false if no lobe was
+// sampled. Initial candidates and path regeneration share it, so that both build the same paths.
+bool bsdf_vertex(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out Vertex next) {
+    s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
+    if (s.lobe == LOBE_NONE) return false;
+    vec3 side = dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal;
+    Hit hit = trace_closest(offset_ray_origin(x.pos, side), s.wi, SHIFT_RAY_TMAX);
+    next = hit.triangle == NO_HIT ? vertex_escaped(s.wi) : hit_vertex(hit);
+    return true;
+}
+
 // The vertices, lobes and weights of a path regenerated from x1 with `seed`.
 bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
     path.seed = seed;
@@ -134,20 +154,15 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
         uint lobe;
         vec3 weight;
         if (i + 1u == target_length && nee_end) {
-            LightSample ls = sample_light(x.pos, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
-            if (!(ls.pdf > 0.0)) return false;
-            next = ls.triangle == NO_EMITTER ? vertex_escaped(ls.dir) : vertex_on_surface(ls.triangle, x.pos + ls.dir * ls.dist);
-            if (!visible(x, next)) return false;
+            LightSample ls;
+            if (!nee_vertex(x, seed, i, ls, next) || !visible(x, next)) return false;
             float bsdf_pdf;
             vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
             lobe = LOBE_NONE;
             weight = f_cos / ls.pdf;
         } else {
-            BsdfSample s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
-            if (s.lobe == LOBE_NONE) return false;
-            vec3 side = dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal;
-            Hit hit = trace_closest(offset_ray_origin(x.pos, side), s.wi, SHIFT_RAY_TMAX);
-            next = hit.triangle == NO_HIT ? vertex_escaped(s.wi) : hit_vertex(hit);
+            BsdfSample s;
+            if (!bsdf_vertex(x, wo, m, seed, i, s, next)) return false;
             lobe = s.lobe;
             weight = s.weight;
         }

@@ -330,8 +330,8 @@ fn render_restir(
         let stats = renderer.frame(scene, frame_camera(args, frame), args.static_camera)?;
         let image = renderer.image()?;
         outputs.write_frame(frame, &image)?;
-        let frame_ms = stats.gpu_ms();
-        gpu_ms += frame_ms.unwrap_or(stats.wall_ms);
+        let frame_ms = stats.gpu_ms().unwrap_or(stats.wall_ms);
+        gpu_ms += frame_ms;
         let detail = RestirFrameReport::from_stats(frame + 1, &stats);
         let frame_report = RenderReport {
             device: ctx.info.name.clone(),
@@ -341,9 +341,9 @@ fn render_restir(
             height: settings.height,
             spp: restir.candidates,
             max_depth: settings.max_depth,
-            gpu_ms: frame_ms.unwrap_or(stats.wall_ms),
+            gpu_ms: frame_ms,
             wall_ms: stats.wall_ms,
-            paths_per_second: settings.pixel_count() as f64 * restir.candidates as f64 / (frame_ms.unwrap_or(stats.wall_ms) * 1e-3),
+            paths_per_second: settings.pixel_count() as f64 * restir.candidates as f64 / (frame_ms * 1e-3),
             restir: Some(detail.clone()),
         };
         println!(
