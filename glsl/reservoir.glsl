@@ -64,20 +64,25 @@ Reservoir reservoir_join(ReservoirHead h, ReservoirTail t) {
 
 // Streaming weighted selection: after add() of candidates with weights w_i, `chosen` is candidate
 // i with probability w_i / sum w and W = sum w / p̂(chosen).
+// `expected` is the expectation of f(Y) W_Y over the choice, sum w_i f(y_i) / p̂(y_i): the
+// pixel is shaded with it, which removes the choice's noise (chiefly colour noise, as p̂ is
+// luminance) without bias. Twin: gris::resampled_expectation.
 struct Resampler {
     PathRecord chosen;
     float chosen_target;
     float weight_sum;
     float confidence;
+    vec3 expected;
 };
 
 Resampler resampler_begin() {
-    return Resampler(reservoir_empty().record, 0.0, 0.0, 0.0);
+    return Resampler(reservoir_empty().record, 0.0, 0.0, 0.0, vec3(0.0));
 }
 
 // `u` uniform in [0, 1); `w` finite and positive.
 void resampler_add(inout Resampler s, PathRecord y, float target, float w, float u) {
     s.weight_sum += w;
+    s.expected += (w / target) * y.contribution;
     if (u * s.weight_sum < w) {
         s.chosen = y;
         s.chosen_target = target;

@@ -58,6 +58,9 @@ layout(std430, set = 0, binding = 17) buffer RestirStats {
     uint nonfinite_pixels;
     uint stats_pad;
 };
+// rgb: the expectation of f(Y) W_Y over the last resampling's choice (see Resampler), written by
+// whichever pass last resampled the pixel.
+layout(std430, set = 0, binding = 18) buffer Expectation { vec4 expectation[]; };
 
 layout(push_constant) uniform RestirPass {
     uint in_slot;

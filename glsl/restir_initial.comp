@@ -40,6 +40,7 @@ void main() {
         }
         store_surface(surface_slot, pixel, surface);
         direct[pixel] = vec4(emitted, 0.0);
+        expectation[pixel] = vec4(s.expected, 0.0);
         store_reservoir(out_slot, pixel, resampler_finish(s));
     }
     report_pass_stats();

@@ -105,8 +105,8 @@ float mis_weight(uint n, uint i, PathRecord y, float p0, float jacobian) {
 }
 
 // Resamples inputs[0..n-1] (0: the canonical pixel's own reservoir) into one reservoir of the
-// canonical domain; `seed` keys the choice.
-Reservoir resample_inputs(uint n, uint seed) {
+// canonical domain; `seed` keys the choice. `expected` receives E[f(Y) W_Y] over the choice.
+Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
     Resampler s = resampler_begin();
     for (uint i = 0u; i < n; ++i) {
         loop_tick();
@@ -130,6 +130,7 @@ Reservoir resample_inputs(uint n, uint seed) {
         }
         if (w > 0.0) resampler_add(s, y, p0, w, rng_uniform4(seed, i, STREAM_RESAMPLE).x);
     }
+    expected = s.expected;
     return resampler_finish(s);
 }
 

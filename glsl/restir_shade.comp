@@ -1,5 +1,6 @@
 #version 460
-// ReSTIR PT pass 4: the pixel's estimate, the emission seen at the primary hit plus f(Y) W_Y,
+// ReSTIR PT pass 4: the pixel's estimate, the emission seen at the primary hit plus the last
+// resampling's expectation of f(Y) W_Y (the same mean as f(Y) W_Y, without the choice's noise),
 // added to the accumulation (the average of a static camera's frames). Non-finite estimates are
 // counted, not clamped.
 #extension GL_GOOGLE_include_directive : require
@@ -13,9 +14,7 @@ void main() {
     bool inside = p.x < width && p.y < height;
     uint pixel = p.y * width + p.x;
     if (inside) {
-        Reservoir r = load_reservoir(in_slot, pixel);
-        vec3 estimate = direct[pixel].rgb;
-        if (r.W > 0.0) estimate += r.record.contribution * r.W;
+        vec3 estimate = direct[pixel].rgb + expectation[pixel].rgb;
         if (any(isnan(estimate)) || any(isinf(estimate))) local_nonfinite_pixels += 1u;
         accum[pixel] += vec4(estimate, 1.0);
         accum_sq[pixel].rgb += estimate * estimate;

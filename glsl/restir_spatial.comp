@@ -34,7 +34,9 @@ void main() {
                 inputs[n] = ReuseInput(res, other.camera, surface_vertex(other), res.M);
                 n += 1u;
             }
-            result = resample_inputs(n, seed);
+            vec3 expected;
+            result = resample_inputs(n, seed, expected);
+            expectation[pixel] = vec4(expected, 0.0);
         }
         store_reservoir(out_slot, pixel, result);
     }

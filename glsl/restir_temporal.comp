@@ -37,7 +37,9 @@ void main() {
                 Reservoir prev = load_reservoir(prev_slot, prev_pixel);
                 float confidence = min(prev.M, m_cap * canonical.M);
                 inputs[1] = ReuseInput(prev, prev_surface.camera, surface_vertex(prev_surface), confidence);
-                result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed));
+                vec3 expected;
+                result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed), expected);
+                expectation[pixel] = vec4(expected, 0.0);
             }
         }
         store_reservoir(out_slot, pixel, result);

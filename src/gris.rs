@@ -77,9 +77,9 @@ pub fn mis_weight<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: 
     }
 }
 
-/// The resampled sample Y and its unbiased contribution weight W_Y; `None` if every weight is
-/// zero. `u` in [0, 1) picks among the candidates.
-pub fn resample<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: Mis, u: f64) -> Option<(S, f64)> {
+/// Every input that shifts into the target domain, with its resampling weight
+/// w_i = m_i(y_i) p̂(y_i) W_i |T_i'(x_i)|; failed shifts and zero or non-finite weights drop out.
+fn weighted_candidates<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: Mis) -> Vec<(S, f64)> {
     let mut candidates = Vec::with_capacity(inputs.len());
     for (i, input) in inputs.iter().enumerate() {
         let shifted = if i == 0 {
@@ -94,6 +94,13 @@ pub fn resample<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: Mi
             candidates.push((y, w));
         }
     }
+    candidates
+}
+
+/// The resampled sample Y and its unbiased contribution weight W_Y; `None` if every weight is
+/// zero. `u` in [0, 1) picks among the candidates.
+pub fn resample<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: Mis, u: f64) -> Option<(S, f64)> {
+    let candidates = weighted_candidates(domains, inputs, mis);
     let total: f64 = candidates.iter().map(|c| c.1).sum();
     if !(total > 0.0) {
         return None;
@@ -105,4 +112,14 @@ pub fn resample<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: Mi
     });
     let (y, _) = *chosen.unwrap_or(candidates.last().expect("total > 0 means a candidate"));
     Some((y, total / domains.target(y)))
+}
+
+/// The expectation of `integrand(Y) W_Y` over the choice of Y among the candidates,
+/// sum_i w_i integrand(y_i) / p̂(y_i): the same estimator without the selection noise (Rao-
+/// Blackwellized). The renderer shades with it, where the integrand is RGB and p̂ its luminance.
+pub fn resampled_expectation<S: Copy>(domains: &impl Domains<S>, inputs: &[Input<S>], mis: Mis, integrand: impl Fn(S) -> f64) -> f64 {
+    weighted_candidates(domains, inputs, mis)
+        .iter()
+        .map(|&(y, w)| w * integrand(y) / domains.target(y))
+        .sum()
 }

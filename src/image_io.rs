@@ -30,7 +30,7 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
 }
 
-fn srgb_encode(linear: f32) -> u8 {
+pub(crate) fn srgb_encode(linear: f32) -> u8 {
     let c = linear.clamp(0.0, 1.0);
     let s = if c <= 0.0031308 {
         12.92 * c

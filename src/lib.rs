@@ -7,6 +7,7 @@
 pub mod bsdf;
 pub mod bundled_scenes;
 pub mod bvh;
+pub mod charts;
 pub mod cli;
 pub mod error;
 pub mod gltf_writer;
@@ -14,6 +15,7 @@ pub mod gpu_types;
 pub mod gris;
 pub mod image_io;
 pub mod lights;
+pub mod metrics;
 pub mod path_record;
 pub mod render;
 pub mod rng;

@@ -31,6 +31,12 @@ enum Command {
     Reference(ReferenceCmd),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
     Profile(ProfileCmd),
+    /// Error against GPU time per frame for each method at equal time budgets, against a
+    /// reference: results.csv, log-log charts (SVG, PNG) and an equal-time image strip.
+    Compare(CompareCmd),
+    /// Every scene and method over F frames, static and moving camera: non-finite pixels (must
+    /// be 0), energy and relMSE per frame against references, flicker and failed-shift rate.
+    Stability(StabilityCmd),
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -250,6 +256,72 @@ struct ProfileCmd {
     device: DeviceOpts,
 }
 
+#[derive(Args)]
+struct CompareCmd {
+    scene: PathBuf,
+    /// Path-traced reference EXR (see `reference`); it sets the resolution.
+    #[arg(long)]
+    reference: PathBuf,
+    /// Methods: pt, restir:reconnection, restir:replay, restir:hybrid (optionally /gbh or /pairwise).
+    #[arg(long, value_delimiter = ',', default_value = "pt,restir:reconnection,restir:replay,restir:hybrid")]
+    methods: Vec<String>,
+    /// GPU ms per frame (default: ReSTIR PT's cheapest frame times 1.05, 2.1 and 4.2). Each method
+    /// spends a budget on path-tracer spp or ReSTIR PT candidates.
+    #[arg(long, value_delimiter = ',')]
+    budgets_ms: Vec<f64>,
+    /// Frames of a static camera per run; the error is measured on the last frame alone.
+    #[arg(long, default_value_t = 16)]
+    frames: u32,
+    /// Independent runs per method and budget (errors averaged, times median).
+    #[arg(long, default_value_t = 1)]
+    trials: u32,
+    #[arg(long, default_value_t = 7)]
+    max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    camera: usize,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    #[command(flatten)]
+    restir: RestirOpts,
+    /// Folder for results.csv, the charts and equal_time.png.
+    #[arg(long, default_value = "out/compare")]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct StabilityCmd {
+    /// Scenes to run (default: every bundled scene).
+    #[arg(long, value_delimiter = ',')]
+    scenes: Vec<PathBuf>,
+    #[arg(long, value_delimiter = ',', default_value = "pt,restir:reconnection,restir:replay,restir:hybrid")]
+    methods: Vec<String>,
+    #[arg(long, default_value_t = 16)]
+    frames: u32,
+    #[arg(long, default_value_t = 64)]
+    width: u32,
+    #[arg(long, default_value_t = 64)]
+    height: u32,
+    #[arg(long, default_value_t = 7)]
+    max_depth: u32,
+    /// Paths per pixel of each camera pose's path-traced reference.
+    #[arg(long, default_value_t = 512)]
+    reference_spp: u32,
+    /// Paths per pixel of one path-traced frame.
+    #[arg(long, default_value_t = 4)]
+    pt_spp: u32,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    #[command(flatten)]
+    restir: RestirOpts,
+    /// Folder for stability.csv and <scene>_rel_mse.svg/png.
+    #[arg(long, default_value = "out/stability")]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    device: DeviceOpts,
+}
+
 impl From<DeviceOpts> for DeviceArgs {
     fn from(d: DeviceOpts) -> Self {
         DeviceArgs {
@@ -313,6 +385,36 @@ fn main() -> ExitCode {
             out_dir: p.out_dir,
             device: p.device.into(),
         }),
+        Command::Compare(c) => cli::compare(cli::CompareArgs {
+            restir: c.restir.settings(),
+            scene: c.scene,
+            reference: c.reference,
+            methods: c.methods,
+            budgets_ms: c.budgets_ms,
+            frames: c.frames,
+            trials: c.trials,
+            max_depth: c.max_depth,
+            camera: c.camera,
+            seed: c.seed,
+            out_dir: c.out_dir,
+            device: c.device.into(),
+        })
+        .map(|_| ()),
+        Command::Stability(s) => cli::stability(cli::StabilityArgs {
+            restir: s.restir.settings(),
+            scenes: s.scenes,
+            methods: s.methods,
+            frames: s.frames,
+            width: s.width,
+            height: s.height,
+            max_depth: s.max_depth,
+            reference_spp: s.reference_spp,
+            pt_spp: s.pt_spp,
+            seed: s.seed,
+            out_dir: Some(s.out_dir),
+            device: s.device.into(),
+        })
+        .map(|_| ()),
         Command::Bench(b) => cli::bench(cli::BenchArgs {
             scene: b.scene,
             width: b.width,

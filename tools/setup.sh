@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Installs every system package restir-pt needs on Debian/Ubuntu: lavapipe (Mesa's CPU Vulkan
 # driver), the Vulkan loader and validation layer, and the static glslang/shaderc/SPIRV-Tools
-# archives that .cargo/config.toml links. Idempotent and non-interactive; runs as root or via sudo.
+# archives that .cargo/config.toml links, and the font the charts of `compare` and `stability` use. Idempotent and non-interactive; runs as root or via sudo.
 set -euo pipefail
 
 packages=(
   mesa-vulkan-drivers libvulkan1 vulkan-validationlayers vulkan-tools
   glslang-tools glslang-dev spirv-tools libshaderc-dev
   build-essential pkg-config
+  fonts-dejavu-core
 )
 
 if [ "$(id -u)" -eq 0 ]; then

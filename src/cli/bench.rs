@@ -7,6 +7,7 @@ use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use crate::metrics::median;
 use crate::render::{PathTracer, RenderSettings};
 
 pub struct BenchArgs {
@@ -35,16 +36,6 @@ struct BenchReport {
     min_paths_per_second: f64,
     max_paths_per_second: f64,
     median_gpu_ms: f64,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 pub fn bench(args: BenchArgs) -> Result<()> {
@@ -93,10 +84,10 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         max_depth: settings.max_depth,
         russian_roulette: settings.russian_roulette,
         runs,
-        median_paths_per_second: median(rates.clone()),
+        median_paths_per_second: median(&rates),
         min_paths_per_second: rates.iter().copied().fold(f64::INFINITY, f64::min),
         max_paths_per_second: rates.iter().copied().fold(0.0, f64::max),
-        median_gpu_ms: median(gpu_ms),
+        median_gpu_ms: median(&gpu_ms),
     };
     println!(
         "{} | {} {}x{} | {} spp | depth {} | median of {} runs: {:.3} M paths/s (min {:.3}, max {:.3})",

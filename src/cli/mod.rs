@@ -1,16 +1,22 @@
 //! The commands behind the CLI; main.rs only parses arguments into these structs.
 
 mod bench;
+mod compare;
 mod info;
+mod method_spec;
 mod profile;
 mod reference;
 mod render;
+mod stability;
 
 pub use bench::{bench, BenchArgs};
+pub use compare::{compare, CompareArgs, CompareRow};
 pub use info::info;
+pub use method_spec::MethodSpec;
 pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, Method, RenderArgs};
+pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context as _, Result};
 
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use crate::metrics::quantile;
 use crate::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
 
 pub struct ProfileArgs {
@@ -19,14 +20,6 @@ pub struct ProfileArgs {
     pub restir: RestirSettings,
     pub out_dir: PathBuf,
     pub device: DeviceArgs,
-}
-
-/// The q-quantile (0..=1) of `values` by the nearest-rank method.
-fn quantile(values: &[f64], q: f64) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(|a, b| a.total_cmp(b));
-    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
-    v[rank - 1]
 }
 
 const PASS_COLOURS: [&str; 4] = ["#4c72b0", "#dd8452", "#55a868", "#c44e52"];

@@ -55,6 +55,7 @@ pub struct Restir {
     _heads: [Buffer; RESERVOIR_SLOTS],
     _tails: [Buffer; RESERVOIR_SLOTS],
     _direct: Buffer,
+    _expectation: Buffer,
     accum: Buffer,
     accum_sq: Buffer,
     stats: Buffer,
@@ -111,17 +112,18 @@ impl Restir {
         let accum = storage("accumulation", pixels * 16)?;
         let accum_sq = storage("accumulation of squares", pixels * 16)?;
         let stats = storage("ReSTIR statistics", std::mem::size_of::<RestirStats>() as u64)?;
+        let expectation = storage("resampled expectation", pixels * 16)?;
 
         let mut bindings = scene_gpu.bindings();
         bindings.push(Binding::Uniform);
-        bindings.extend([Binding::Storage; 12]);
+        bindings.extend([Binding::Storage; 13]);
         let mut buffers = scene_gpu.buffers(&params);
         buffers.push(&reuse);
         buffers.extend(surfaces.iter());
         for (h, t) in heads.iter().zip(&tails) {
             buffers.extend([h, t]);
         }
-        buffers.extend([&direct, &accum, &accum_sq, &stats]);
+        buffers.extend([&direct, &accum, &accum_sq, &stats, &expectation]);
         let mut defines = scene_gpu.defines();
         defines.extend(restir.defines());
         let push = std::mem::size_of::<RestirPass>() as u32;
@@ -150,6 +152,7 @@ impl Restir {
             _heads: heads,
             _tails: tails,
             _direct: direct,
+            _expectation: expectation,
             accum,
             accum_sq,
             stats,
@@ -172,6 +175,18 @@ impl Restir {
         self.history = None;
         self.frame_index = 0;
         self.settings.seed = seed;
+        Ok(())
+    }
+
+    /// Changes the initial paths per pixel of the next frames (a frame-cost knob; the kernels
+    /// stay compiled).
+    pub fn set_candidates(&mut self, candidates: u32) -> Result<()> {
+        let restir = RestirSettings {
+            candidates,
+            ..self.restir.clone()
+        };
+        restir.validate(self.settings.max_depth)?;
+        self.restir = restir;
         Ok(())
     }
 

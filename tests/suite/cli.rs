@@ -287,3 +287,67 @@ fn cli_reference_and_profile_write_their_files() {
         assert!(stdout.lines().any(|l| l.starts_with(pass)), "{pass} median/p95 missing: {stdout}");
     }
 }
+
+#[test]
+fn cli_compare_writes_results_charts_and_strip() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().join("compare");
+    let reference = dir.join("ref.exr");
+    let (code, _, stderr) = restir_pt(&[
+        "reference",
+        "scenes/cornell.gltf",
+        "--spp",
+        "64",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let budgets = ["1000", "2000"];
+    let (code, stdout, stderr) = restir_pt(&[
+        "compare",
+        "scenes/cornell.gltf",
+        "--reference",
+        reference.to_str().unwrap(),
+        "--methods",
+        "pt,restir:hybrid",
+        "--budgets-ms",
+        &budgets.join(","),
+        "--frames",
+        "3",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 4, "{csv}");
+    for row in &rows {
+        let rel_mse: f64 = row[4].parse().unwrap();
+        let gpu_ms: f64 = row[3].parse().unwrap();
+        assert!(rel_mse.is_finite() && rel_mse > 0.0 && gpu_ms > 0.0, "{row:?}");
+        assert_eq!(row[8], "0", "non-finite pixels: {row:?}");
+    }
+    // A larger budget buys the path tracer more samples per frame.
+    let spp = |r: &Vec<&str>| r[2].trim_start_matches("spp=").parse::<u32>().unwrap();
+    assert!(rows[0][0] == "pt" && rows[1][0] == "pt" && spp(&rows[1]) > spp(&rows[0]), "{csv}");
+    assert!(rows[2][2].starts_with("candidates="), "{csv}");
+    assert!(stdout.contains("equal time 1000.0 ms: pt relMSE"), "{stdout}");
+    for chart in ["rel_mse_vs_time", "mse_vs_time"] {
+        assert!(std::fs::read_to_string(dir.join(format!("{chart}.svg"))).unwrap().contains("<svg"));
+        assert!(std::fs::read(dir.join(format!("{chart}.png"))).unwrap().starts_with(b"\x89PNG"));
+    }
+    assert!(std::fs::read(dir.join("equal_time.png")).unwrap().starts_with(b"\x89PNG"));
+
+    assert_clean_failure(
+        &["compare", "scenes/cornell.gltf", "--reference", reference.to_str().unwrap(), "--methods", "pt,restir:sideways"],
+        &["restir:sideways", "unknown shift"],
+    );
+    assert_clean_failure(
+        &["compare", "scenes/cornell.gltf", "--reference", reference.to_str().unwrap(), "--budgets-ms=0"],
+        &["--budgets-ms 0"],
+    );
+    assert_clean_failure(&["compare", "scenes/cornell.gltf", "--reference", "missing.exr"], &["missing.exr"]);
+}

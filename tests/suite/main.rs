@@ -17,3 +17,4 @@ mod sampling_statistics;
 mod scene_loader;
 mod scenes;
 mod shift;
+mod speed_accuracy;

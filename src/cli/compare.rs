@@ -1,0 +1,351 @@
+//! `restir-pt compare`: error against GPU time per frame for each method, at equal time budgets,
+//! against a path-traced reference. Writes results.csv, error-against-time charts (SVG and PNG)
+//! and an equal-time image strip with insets.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context as _, Result};
+use glam::Vec3;
+
+use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
+use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
+use crate::image_io::read_exr;
+use crate::metrics::{energy_ratio, median, mse, rel_mse};
+use crate::render::{Image, RenderSettings, RestirSettings, MAX_CANDIDATES};
+use crate::scene::Scene;
+
+pub struct CompareArgs {
+    pub scene: PathBuf,
+    pub reference: PathBuf,
+    pub methods: Vec<String>,
+    /// GPU ms per frame; empty: ReSTIR PT's one-candidate frame cost times 1, 2 and 4.
+    pub budgets_ms: Vec<f64>,
+    /// Frames per run (static camera); the error is the last frame's.
+    pub frames: u32,
+    /// Independent runs per method and budget; errors are averaged, times are medians.
+    pub trials: u32,
+    pub max_depth: u32,
+    pub camera: usize,
+    pub seed: u32,
+    pub restir: RestirSettings,
+    pub out_dir: PathBuf,
+    pub device: DeviceArgs,
+}
+
+/// One method at one budget.
+pub struct CompareRow {
+    pub method: String,
+    pub budget_ms: f64,
+    /// The cost knob chosen to fit the budget: path-tracer spp or ReSTIR PT candidates.
+    pub knob: String,
+    pub gpu_ms_per_frame: f64,
+    pub rel_mse: f64,
+    pub mse: f64,
+    pub energy_ratio: f64,
+    pub failed_shift_rate: Option<f64>,
+    pub nonfinite_pixels: usize,
+}
+
+/// A method's frame cost, measured after its kernels are compiled.
+enum Cost {
+    /// GPU ms per path-traced sample per pixel.
+    PerSample(f64),
+    /// ReSTIR PT: GPU ms of a frame with one candidate, and per extra candidate.
+    Frame { base: f64, per_candidate: f64 },
+}
+
+impl Cost {
+    /// The knob value that fits `budget_ms`, or None if even the cheapest frame does not.
+    fn fit(&self, budget_ms: f64) -> Option<u32> {
+        match *self {
+            Cost::PerSample(ms) => Some(((budget_ms / ms).floor() as u32).max(1)),
+            Cost::Frame { base, per_candidate } => {
+                if base > budget_ms {
+                    return None;
+                }
+                let extra = ((budget_ms - base) / per_candidate.max(1e-6)).floor() as u32;
+                Some((1 + extra).min(MAX_CANDIDATES))
+            }
+        }
+    }
+}
+
+struct Run<'a> {
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+}
+
+/// What `Run::sequence` measured.
+struct Sequence {
+    gpu_ms_per_frame: f64,
+    failed_shift_rate: Option<f64>,
+    last_frame: Image,
+}
+
+impl Run<'_> {
+    /// `frames` frames of a static camera from one seed: the median GPU ms per frame (from the
+    /// second frame on, once ReSTIR has a history), the failed-shift rate, and the last frame.
+    fn sequence(&self, renderer: &mut MethodRenderer, frames: u32, seed: u32) -> Result<Sequence> {
+        let settings = RenderSettings {
+            seed,
+            ..self.settings.clone()
+        };
+        renderer.reset(self.scene, &settings)?;
+        let (mut times, mut failed, mut last) = (vec![], vec![], None);
+        for f in 0..frames {
+            let (outcome, image) = renderer.frame(self.scene, &settings, settings.camera, f)?;
+            if f > 0 || frames == 1 {
+                times.push(outcome.gpu_ms);
+            }
+            failed.extend(outcome.failed_shift_rate);
+            last = Some(image);
+        }
+        Ok(Sequence {
+            gpu_ms_per_frame: median(&times),
+            failed_shift_rate: (!failed.is_empty()).then(|| failed.iter().sum::<f64>() / failed.len() as f64),
+            last_frame: last.expect("at least one frame"),
+        })
+    }
+
+    /// Measures a method's frame cost. The first run compiles the kernels (llvmpipe compiles at
+    /// the first dispatch) and is not counted.
+    fn calibrate(&self, renderer: &mut MethodRenderer) -> Result<Cost> {
+        match renderer {
+            MethodRenderer::PathTracing(..) => {
+                renderer.set_cost_knob(1)?;
+                self.sequence(renderer, 1, 0)?;
+                const SAMPLES: u32 = 8;
+                renderer.set_cost_knob(SAMPLES)?;
+                let ms = self.sequence(renderer, 1, 0)?.gpu_ms_per_frame;
+                Ok(Cost::PerSample(ms / SAMPLES as f64))
+            }
+            MethodRenderer::Restir(_) => {
+                const FRAMES: u32 = 4;
+                renderer.set_cost_knob(1)?;
+                self.sequence(renderer, FRAMES, 0)?;
+                let base = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
+                renderer.set_cost_knob(2)?;
+                let two = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
+                Ok(Cost::Frame {
+                    base,
+                    per_candidate: (two - base).max(0.05 * base),
+                })
+            }
+        }
+    }
+}
+
+/// The inset window: the square (a quarter of the image's width) where `image` is furthest
+/// from the reference.
+fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> Inset {
+    let size = (width.min(height) / 4).max(4).min(width.min(height));
+    let error = |x: u32, y: u32| {
+        let i = (y * width + x) as usize;
+        let d = image[i] - reference[i];
+        (d * d / (reference[i] * reference[i] + Vec3::splat(1e-2))).element_sum() as f64
+    };
+    let mut best = (f64::NEG_INFINITY, Inset { x: 0, y: 0, size });
+    let step = (size / 2).max(1);
+    for y in (0..=height - size).step_by(step as usize) {
+        for x in (0..=width - size).step_by(step as usize) {
+            let e: f64 = (y..y + size).flat_map(|yy| (x..x + size).map(move |xx| (xx, yy))).map(|(xx, yy)| error(xx, yy)).filter(|e| e.is_finite()).sum();
+            if e > best.0 {
+                best = (e, Inset { x, y, size });
+            }
+        }
+    }
+    best.1
+}
+
+fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
+    let mut csv = String::from("method,budget_ms,knob,gpu_ms_per_frame,rel_mse,mse,energy_ratio,failed_shift_rate,nonfinite_pixels\n");
+    for r in rows {
+        let _ = writeln!(
+            csv,
+            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.5},{},{}",
+            r.method,
+            r.budget_ms,
+            r.knob,
+            r.gpu_ms_per_frame,
+            r.rel_mse,
+            r.mse,
+            r.energy_ratio,
+            r.failed_shift_rate.map(|f| format!("{f:.5}")).unwrap_or_default(),
+            r.nonfinite_pixels
+        );
+    }
+    std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Runs every method at every budget; returns the rows and writes the CSV, charts and strip.
+pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
+    if args.frames == 0 || args.trials == 0 {
+        bail!("--frames and --trials must be at least 1");
+    }
+    if let Some(b) = args.budgets_ms.iter().find(|b| !(**b > 0.0) || !b.is_finite()) {
+        bail!("--budgets-ms {b}: a budget must be a positive number of milliseconds");
+    }
+    let path = scene_path(Some(&args.scene));
+    let scene = load_with_warnings(&path)?;
+    let (width, height, reference) = read_exr(&args.reference)?;
+    if let Some(i) = reference.iter().position(|p| !p.is_finite()) {
+        bail!("{}: the reference has a non-finite pixel ({}, {})", args.reference.display(), i as u32 % width, i as u32 / width);
+    }
+    let methods = parse_methods(&args.methods, &args.restir)?;
+    let settings = RenderSettings {
+        width,
+        height,
+        spp: 1,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        camera: args.camera,
+        ..Default::default()
+    };
+    settings.validate(&scene)?;
+    for m in &methods {
+        if let MethodSpec::Restir(r) = m {
+            r.validate(settings.max_depth)?;
+        }
+    }
+    std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
+    let ctx = open_device(&args.device)?;
+    let run = Run {
+        scene: &scene,
+        settings: &settings,
+    };
+    let mut renderers = vec![];
+    for m in &methods {
+        let mut renderer = MethodRenderer::new(&ctx, &scene, &settings, m)?;
+        let cost = run.calibrate(&mut renderer)?;
+        renderers.push((m.label(), renderer, cost));
+    }
+    let budgets = if args.budgets_ms.is_empty() {
+        let cheapest_restir = renderers
+            .iter()
+            .filter_map(|(_, _, c)| match c {
+                Cost::Frame { base, .. } => Some(*base),
+                Cost::PerSample(_) => None,
+            })
+            .fold(f64::INFINITY, f64::min);
+        let unit = if cheapest_restir.is_finite() { cheapest_restir * 1.05 } else { 10.0 };
+        vec![unit, 2.0 * unit, 4.0 * unit]
+    } else {
+        args.budgets_ms.clone()
+    };
+
+    let mut rows = vec![];
+    let mut images: Vec<(String, f64, Image)> = vec![];
+    for (label, renderer, cost) in &mut renderers {
+        for &budget in &budgets {
+            let Some(knob) = cost.fit(budget) else {
+                eprintln!("{label}: skipped at {budget:.1} ms, its cheapest frame does not fit");
+                continue;
+            };
+            renderer.set_cost_knob(knob)?;
+            let (mut times, mut rel, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, None, 0);
+            let mut last = None;
+            for t in 0..args.trials {
+                let seq = run.sequence(renderer, args.frames, args.seed.wrapping_add(1 + t))?;
+                times.push(seq.gpu_ms_per_frame);
+                rel += rel_mse(&seq.last_frame.mean, &reference) / args.trials as f64;
+                abs += mse(&seq.last_frame.mean, &reference) / args.trials as f64;
+                energy += energy_ratio(&seq.last_frame.mean, &reference) / args.trials as f64;
+                failed = seq.failed_shift_rate.map(|f| failed.unwrap_or(0.0) + f / args.trials as f64);
+                nonfinite += seq.last_frame.non_finite_count();
+                last = Some(seq.last_frame);
+            }
+            let row = CompareRow {
+                method: label.clone(),
+                budget_ms: budget,
+                knob: format!("{}={knob}", renderer.cost_knob_name()),
+                gpu_ms_per_frame: median(&times),
+                rel_mse: rel,
+                mse: abs,
+                energy_ratio: energy,
+                failed_shift_rate: failed,
+                nonfinite_pixels: nonfinite,
+            };
+            println!(
+                "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e} | MSE {:.4e} | energy {:.4}{}",
+                row.method,
+                budget,
+                row.knob,
+                row.gpu_ms_per_frame,
+                row.rel_mse,
+                row.mse,
+                row.energy_ratio,
+                row.failed_shift_rate.map(|f| format!(" | failed shifts {:.2}%", 100.0 * f)).unwrap_or_default()
+            );
+            images.push((label.clone(), budget, last.expect("at least one trial")));
+            rows.push(row);
+        }
+    }
+    drop(renderers);
+    finish_device(&ctx)?;
+    report_equal_time(&rows, &budgets);
+
+    write_csv(&args.out_dir.join("results.csv"), &rows)?;
+    let title = format!("{} {}x{}, frame {} of a static camera, {}", path.display(), width, height, args.frames, ctx.info.name);
+    for (metric, name, value) in [("rel_mse", "relMSE", (|r: &CompareRow| r.rel_mse) as fn(&CompareRow) -> f64), ("mse", "MSE", |r| r.mse)] {
+        let series: Vec<Series> = methods
+            .iter()
+            .map(|m| Series {
+                name: m.label(),
+                points: rows.iter().filter(|r| r.method == m.label()).map(|r| (r.gpu_ms_per_frame, value(r))).collect(),
+            })
+            .collect();
+        write_line_chart(
+            &args.out_dir.join(format!("{metric}_vs_time")),
+            &LineChart {
+                title: &title,
+                x_label: "GPU ms per frame",
+                y_label: name,
+                log_x: true,
+                series: &series,
+            },
+        )?;
+    }
+    write_strip(&args.out_dir.join("equal_time.png"), &budgets, &methods, &images, &reference, width, height)?;
+    eprintln!("wrote results.csv, rel_mse_vs_time.svg/png, mse_vs_time.svg/png and equal_time.png in {}", args.out_dir.display());
+    Ok(rows)
+}
+
+/// For each budget where the path tracer and ReSTIR PT both ran: the path tracer's relMSE over
+/// the best ReSTIR PT method's.
+fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
+    for &budget in budgets {
+        let at = |pred: &dyn Fn(&CompareRow) -> bool| rows.iter().filter(|r| r.budget_ms == budget && pred(r)).min_by(|a, b| a.rel_mse.total_cmp(&b.rel_mse));
+        if let (Some(pt), Some(best)) = (at(&|r| r.method == "pt"), at(&|r| r.method != "pt")) {
+            println!(
+                "equal time {budget:.1} ms: pt relMSE {:.4e} ({:.1} ms) / {} relMSE {:.4e} ({:.1} ms) = {:.2}x",
+                pt.rel_mse,
+                pt.gpu_ms_per_frame,
+                best.method,
+                best.rel_mse,
+                best.gpu_ms_per_frame,
+                pt.rel_mse / best.rel_mse
+            );
+        }
+    }
+}
+
+/// The strip of the largest budget every method fit (or the largest budget run at all).
+fn write_strip(path: &Path, budgets: &[f64], methods: &[MethodSpec], images: &[(String, f64, Image)], reference: &[Vec3], width: u32, height: u32) -> Result<()> {
+    let complete = |b: f64| methods.iter().all(|m| images.iter().any(|(l, ib, _)| *l == m.label() && *ib == b));
+    let Some(budget) = budgets.iter().copied().filter(|&b| complete(b)).fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b)))).or_else(|| images.iter().map(|i| i.1).reduce(f64::max)) else {
+        return Ok(());
+    };
+    let chosen: Vec<&(String, f64, Image)> = images.iter().filter(|i| i.1 == budget).collect();
+    let inset = worst_window(&chosen[0].2.mean, reference, width, height);
+    let mut panels = vec![StripPanel {
+        label: "reference".into(),
+        pixels: reference,
+    }];
+    panels.extend(chosen.iter().map(|(label, _, image)| StripPanel {
+        label: format!("{label} ({:.3} relMSE)", rel_mse(&image.mean, reference)),
+        pixels: &image.mean,
+    }));
+    write_image_strip(path, width, height, &panels, inset)
+}

@@ -1,0 +1,158 @@
+//! The methods `compare` and `stability` run, written `pt` or `restir:SHIFT[/MIS]`, and a
+//! renderer that runs either one frame at a time.
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use anyhow::{bail, Result};
+
+use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind};
+use crate::scene::Scene;
+use crate::vk::Context;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum MethodSpec {
+    PathTracing,
+    Restir(RestirSettings),
+}
+
+impl MethodSpec {
+    /// Parses `pt`, `restir` (the default hybrid shift), `restir:SHIFT` or `restir:SHIFT/MIS`;
+    /// unnamed ReSTIR settings come from `base`.
+    pub fn parse(text: &str, base: &RestirSettings) -> Result<Self> {
+        let text = text.trim();
+        if text == "pt" {
+            return Ok(MethodSpec::PathTracing);
+        }
+        let Some(rest) = text.strip_prefix("restir") else {
+            bail!("method '{text}': expected pt or restir:reconnection|replay|hybrid[/gbh|pairwise]");
+        };
+        let mut settings = base.clone();
+        let rest = match rest.strip_prefix(':') {
+            Some(r) => r,
+            None if rest.is_empty() => return Ok(MethodSpec::Restir(settings)),
+            None => bail!("method '{text}': expected restir:SHIFT"),
+        };
+        let (shift, mis) = match rest.split_once('/') {
+            Some((s, m)) => (s, Some(m)),
+            None => (rest, None),
+        };
+        settings.shift = match shift {
+            "reconnection" => ShiftKind::Reconnection,
+            "replay" => ShiftKind::Replay,
+            "hybrid" => ShiftKind::Hybrid,
+            other => bail!("method '{text}': unknown shift '{other}' (reconnection, replay or hybrid)"),
+        };
+        if let Some(mis) = mis {
+            settings.mis = match mis {
+                "gbh" => ReuseMis::GeneralizedBalance,
+                "pairwise" => ReuseMis::Pairwise,
+                other => bail!("method '{text}': unknown MIS '{other}' (gbh or pairwise)"),
+            };
+        }
+        Ok(MethodSpec::Restir(settings))
+    }
+
+    pub fn label(&self) -> String {
+        match self {
+            MethodSpec::PathTracing => "pt".into(),
+            MethodSpec::Restir(r) => r.label(),
+        }
+    }
+}
+
+/// Parses a comma-separated method list.
+pub fn parse_methods(list: &[String], base: &RestirSettings) -> Result<Vec<MethodSpec>> {
+    if list.is_empty() {
+        bail!("--methods names no method");
+    }
+    list.iter().map(|m| MethodSpec::parse(m, base)).collect()
+}
+
+/// A compiled renderer for one method; its kernels are reused across runs.
+pub enum MethodRenderer {
+    /// The path tracer and its paths per pixel and frame.
+    PathTracing(PathTracer, u32),
+    Restir(Restir),
+}
+
+/// What one frame cost and how its shifts went.
+pub struct FrameOutcome {
+    pub gpu_ms: f64,
+    /// Failed over attempted shifts (ReSTIR PT), None for the path tracer.
+    pub failed_shift_rate: Option<f64>,
+}
+
+impl MethodRenderer {
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, method: &MethodSpec) -> Result<Self> {
+        Ok(match method {
+            MethodSpec::PathTracing => MethodRenderer::PathTracing(PathTracer::new(ctx, scene, settings)?, settings.spp),
+            MethodSpec::Restir(r) => MethodRenderer::Restir(Restir::new(ctx, scene, settings, r)?),
+        })
+    }
+
+    /// Starts an independent sequence with `seed`: the path tracer's sums or ReSTIR's history
+    /// are cleared.
+    pub fn reset(&mut self, scene: &Scene, settings: &RenderSettings) -> Result<()> {
+        match self {
+            MethodRenderer::PathTracing(t, _) => t.restart(scene, settings),
+            MethodRenderer::Restir(r) => r.reset(settings.seed),
+        }
+    }
+
+    /// Sets the frame-cost knob: the path tracer's paths per pixel, or ReSTIR PT's initial
+    /// candidates per pixel.
+    pub fn set_cost_knob(&mut self, value: u32) -> Result<()> {
+        match self {
+            MethodRenderer::PathTracing(_, spp) => {
+                if value == 0 {
+                    bail!("a path-traced frame needs at least 1 sample per pixel");
+                }
+                *spp = value;
+                Ok(())
+            }
+            MethodRenderer::Restir(r) => r.set_candidates(value),
+        }
+    }
+
+    pub fn cost_knob_name(&self) -> &'static str {
+        match self {
+            MethodRenderer::PathTracing(..) => "spp",
+            MethodRenderer::Restir(_) => "candidates",
+        }
+    }
+
+    /// One frame from `camera`: the knob's fresh paths per pixel for the path tracer (its frames
+    /// share nothing), one ReSTIR PT frame (reusing the history) otherwise. The image is the
+    /// frame alone.
+    pub fn frame(&mut self, scene: &Scene, settings: &RenderSettings, camera: usize, frame: u32) -> Result<(FrameOutcome, Image)> {
+        match self {
+            MethodRenderer::PathTracing(t, spp) => {
+                // Distinct frames need distinct random numbers: the seed advances per frame.
+                t.restart(
+                    scene,
+                    &RenderSettings {
+                        camera,
+                        seed: settings.seed.wrapping_mul(0x9e37_79b9).wrapping_add(frame),
+                        spp: *spp,
+                        ..settings.clone()
+                    },
+                )?;
+                let stats = t.render(&|_| {}, &AtomicBool::new(false))?;
+                let outcome = FrameOutcome {
+                    gpu_ms: stats.gpu_ms,
+                    failed_shift_rate: None,
+                };
+                Ok((outcome, t.image()?))
+            }
+            MethodRenderer::Restir(r) => {
+                let stats = r.frame(scene, camera, false)?;
+                let outcome = FrameOutcome {
+                    gpu_ms: stats.gpu_ms().unwrap_or(stats.wall_ms),
+                    failed_shift_rate: Some(stats.failed_shift_rate()),
+                };
+                Ok((outcome, r.image()?))
+            }
+        }
+    }
+}

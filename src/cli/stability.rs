@@ -1,0 +1,300 @@
+//! `restir-pt stability`: every scene and method over F frames with a static and a moving camera:
+//! non-finite pixels, energy and relMSE against a path-traced reference per frame, temporal
+//! flicker and the failed-shift rate. Writes stability.csv and an error-over-frames chart per
+//! scene, and fails if any pixel was not finite.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use anyhow::{bail, Context as _, Result};
+use glam::Vec3;
+
+use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
+use super::{finish_device, load_with_warnings, open_device, DeviceArgs};
+use crate::charts::{write_line_chart, LineChart, Series};
+use crate::metrics::{energy_ratio, flicker, rel_mse};
+use crate::render::{PathTracer, RenderSettings, RestirSettings};
+use crate::scene::Scene;
+
+pub struct StabilityArgs {
+    pub scenes: Vec<PathBuf>,
+    pub methods: Vec<String>,
+    pub frames: u32,
+    pub width: u32,
+    pub height: u32,
+    pub max_depth: u32,
+    /// Paths per pixel of each camera pose's reference.
+    pub reference_spp: u32,
+    /// Paths per pixel of a path-traced frame.
+    pub pt_spp: u32,
+    pub seed: u32,
+    pub restir: RestirSettings,
+    /// Folder for stability.csv and the charts; None writes nothing.
+    pub out_dir: Option<PathBuf>,
+    pub device: DeviceArgs,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraMotion {
+    Static,
+    /// Back and forth along the scene's camera path, one pose per frame.
+    Moving,
+}
+
+impl CameraMotion {
+    pub fn name(self) -> &'static str {
+        match self {
+            CameraMotion::Static => "static",
+            CameraMotion::Moving => "moving",
+        }
+    }
+
+    /// The scene camera of frame `frame` among `cameras` poses.
+    fn camera(self, frame: u32, cameras: usize) -> usize {
+        if self == CameraMotion::Static || cameras < 2 {
+            return 0;
+        }
+        let period = 2 * (cameras - 1);
+        let k = frame as usize % period;
+        if k < cameras {
+            k
+        } else {
+            period - k
+        }
+    }
+}
+
+/// One frame of one method on one scene.
+#[derive(Debug, Clone)]
+pub struct StabilityRow {
+    pub scene: String,
+    pub method: String,
+    pub motion: CameraMotion,
+    pub frame: u32,
+    pub nonfinite_pixels: usize,
+    pub energy_ratio: f64,
+    pub rel_mse: f64,
+    /// Static camera only, from the second frame on.
+    pub flicker: Option<f64>,
+    pub failed_shift_rate: Option<f64>,
+}
+
+/// Path-traced references of a scene's camera poses, made on first use.
+struct References<'a> {
+    tracer: PathTracer,
+    scene: &'a Scene,
+    settings: RenderSettings,
+    images: HashMap<usize, Vec<Vec3>>,
+}
+
+impl References<'_> {
+    fn get(&mut self, camera: usize) -> Result<&[Vec3]> {
+        if !self.images.contains_key(&camera) {
+            let settings = RenderSettings {
+                camera,
+                ..self.settings.clone()
+            };
+            self.tracer.restart(self.scene, &settings)?;
+            self.tracer.render(&|_| {}, &AtomicBool::new(false))?;
+            self.images.insert(camera, self.tracer.image()?.mean);
+        }
+        Ok(&self.images[&camera])
+    }
+}
+
+fn scene_name(path: &Path) -> String {
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
+}
+
+/// The bundled scenes next to the crate, in their documented order.
+pub fn bundled_scene_paths() -> Vec<PathBuf> {
+    crate::bundled_scenes::BUNDLED_SCENES
+        .iter()
+        .map(|s| {
+            let local = Path::new("scenes").join(s.file_name);
+            if local.exists() {
+                local
+            } else {
+                Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(s.file_name)
+            }
+        })
+        .collect()
+}
+
+pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
+    if args.frames < 2 {
+        bail!("--frames must be at least 2 (flicker compares consecutive frames)");
+    }
+    if args.reference_spp == 0 || args.pt_spp == 0 {
+        bail!("--reference-spp and --pt-spp must be at least 1");
+    }
+    let methods = parse_methods(&args.methods, &args.restir)?;
+    let scenes = if args.scenes.is_empty() { bundled_scene_paths() } else { args.scenes.clone() };
+    let loaded: Vec<(PathBuf, Scene)> = scenes.iter().map(|p| Ok((p.clone(), load_with_warnings(p)?))).collect::<Result<_>>()?;
+    let base = RenderSettings {
+        width: args.width,
+        height: args.height,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        ..Default::default()
+    };
+    for (path, scene) in &loaded {
+        base.validate(scene).with_context(|| path.display().to_string())?;
+    }
+    for m in &methods {
+        if let MethodSpec::Restir(r) = m {
+            r.validate(args.max_depth)?;
+        }
+    }
+    if let Some(dir) = &args.out_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
+    }
+    let ctx = open_device(&args.device)?;
+    let mut rows = vec![];
+    for (path, scene) in &loaded {
+        let name = scene_name(path);
+        let reference_settings = RenderSettings {
+            spp: args.reference_spp,
+            seed: args.seed ^ 0x5eed_0f5e,
+            ..base.clone()
+        };
+        let mut references = References {
+            tracer: PathTracer::new(&ctx, scene, &reference_settings)?,
+            scene,
+            settings: reference_settings,
+            images: HashMap::new(),
+        };
+        let mut scene_rows = vec![];
+        for method in &methods {
+            let settings = RenderSettings {
+                spp: args.pt_spp,
+                ..base.clone()
+            };
+            let mut renderer = MethodRenderer::new(&ctx, scene, &settings, method)?;
+            for motion in [CameraMotion::Static, CameraMotion::Moving] {
+                renderer.reset(scene, &settings)?;
+                let mut previous: Option<Vec<Vec3>> = None;
+                for frame in 0..args.frames {
+                    let camera = motion.camera(frame, scene.cameras.len());
+                    let (outcome, image) = renderer.frame(scene, &settings, camera, frame)?;
+                    let reference = references.get(camera)?;
+                    let row = StabilityRow {
+                        scene: name.clone(),
+                        method: method.label(),
+                        motion,
+                        frame,
+                        nonfinite_pixels: image.non_finite_count(),
+                        energy_ratio: energy_ratio(&image.mean, reference),
+                        rel_mse: rel_mse(&image.mean, reference),
+                        flicker: match (motion, &previous) {
+                            (CameraMotion::Static, Some(p)) => Some(flicker(p, &image.mean, reference)),
+                            _ => None,
+                        },
+                        failed_shift_rate: outcome.failed_shift_rate,
+                    };
+                    previous = Some(image.mean);
+                    scene_rows.push(row);
+                }
+            }
+        }
+        print_summary(&scene_rows, &methods);
+        if let Some(dir) = &args.out_dir {
+            write_chart(dir, &name, &scene_rows, &methods)?;
+        }
+        rows.extend(scene_rows);
+    }
+    finish_device(&ctx)?;
+    if let Some(dir) = &args.out_dir {
+        write_csv(&dir.join("stability.csv"), &rows)?;
+        eprintln!("wrote stability.csv and <scene>_rel_mse.svg/png in {}", dir.display());
+    }
+    let nonfinite: usize = rows.iter().map(|r| r.nonfinite_pixels).sum();
+    if nonfinite > 0 {
+        bail!("{nonfinite} non-finite pixels over all frames (see the summary above)");
+    }
+    Ok(rows)
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        sum / n as f64
+    }
+}
+
+/// One line per method and camera motion.
+fn print_summary(rows: &[StabilityRow], methods: &[MethodSpec]) {
+    for m in methods {
+        for motion in [CameraMotion::Static, CameraMotion::Moving] {
+            let run: Vec<&StabilityRow> = rows.iter().filter(|r| r.method == m.label() && r.motion == motion).collect();
+            let Some(last) = run.last() else { continue };
+            let energies = run.iter().map(|r| r.energy_ratio);
+            let (lo, hi) = energies.clone().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| (lo.min(e), hi.max(e)));
+            let flicker = mean(run.iter().filter_map(|r| r.flicker));
+            let failed = mean(run.iter().filter_map(|r| r.failed_shift_rate));
+            println!(
+                "{:<16} {:<26} {:<7} | non-finite {} | energy mean {:.4} [{lo:.3}, {hi:.3}] | relMSE last {:.4e} mean {:.4e}{}{}",
+                last.scene,
+                last.method,
+                motion.name(),
+                run.iter().map(|r| r.nonfinite_pixels).sum::<usize>(),
+                mean(energies),
+                last.rel_mse,
+                mean(run.iter().map(|r| r.rel_mse)),
+                if flicker.is_nan() { String::new() } else { format!(" | flicker {flicker:.4}") },
+                if failed.is_nan() { String::new() } else { format!(" | failed shifts {:.2}%", 100.0 * failed) }
+            );
+        }
+    }
+}
+
+fn write_chart(dir: &Path, scene: &str, rows: &[StabilityRow], methods: &[MethodSpec]) -> Result<()> {
+    let mut series = vec![];
+    for m in methods {
+        for motion in [CameraMotion::Static, CameraMotion::Moving] {
+            series.push(Series {
+                name: format!("{} {}", m.label(), motion.name()),
+                points: rows
+                    .iter()
+                    .filter(|r| r.method == m.label() && r.motion == motion)
+                    .map(|r| (r.frame as f64, r.rel_mse))
+                    .collect(),
+            });
+        }
+    }
+    write_line_chart(
+        &dir.join(format!("{scene}_rel_mse")),
+        &LineChart {
+            title: &format!("{scene}: relMSE of each frame"),
+            x_label: "frame",
+            y_label: "relMSE",
+            log_x: false,
+            series: &series,
+        },
+    )
+}
+
+fn write_csv(path: &Path, rows: &[StabilityRow]) -> Result<()> {
+    let mut csv = String::from("scene,method,camera,frame,nonfinite_pixels,energy_ratio,rel_mse,flicker,failed_shift_rate\n");
+    let optional = |v: Option<f64>| v.map(|x| format!("{x:.6}")).unwrap_or_default();
+    for r in rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{:.6},{:.6e},{},{}",
+            r.scene,
+            r.method,
+            r.motion.name(),
+            r.frame,
+            r.nonfinite_pixels,
+            r.energy_ratio,
+            r.rel_mse,
+            optional(r.flicker),
+            optional(r.failed_shift_rate)
+        );
+    }
+    std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))
+}

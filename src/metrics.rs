@@ -1,0 +1,84 @@
+//! Image error metrics against a reference: relMSE, MSE, energy and frame-to-frame flicker.
+
+use glam::Vec3;
+
+/// Guards relMSE's denominator where the reference is black (the usual 1e-2 of the literature).
+pub const REL_MSE_EPSILON: f32 = 1e-2;
+
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+fn check_sizes(image: &[Vec3], reference: &[Vec3]) {
+    assert_eq!(image.len(), reference.len(), "an image and its reference differ in size");
+}
+
+/// Mean over pixels and channels of (x - r)^2 / (r^2 + 1e-2), accumulated in f64.
+pub fn rel_mse(image: &[Vec3], reference: &[Vec3]) -> f64 {
+    check_sizes(image, reference);
+    let sum: f64 = image
+        .iter()
+        .zip(reference)
+        .map(|(x, r)| {
+            let d = *x - *r;
+            let rel = d * d / (*r * *r + Vec3::splat(REL_MSE_EPSILON));
+            (rel.x + rel.y + rel.z) as f64
+        })
+        .sum();
+    sum / (3 * image.len().max(1)) as f64
+}
+
+/// Mean over pixels and channels of (x - r)^2.
+pub fn mse(image: &[Vec3], reference: &[Vec3]) -> f64 {
+    check_sizes(image, reference);
+    let sum: f64 = image.iter().zip(reference).map(|(x, r)| (*x - *r).length_squared() as f64).sum();
+    sum / (3 * image.len().max(1)) as f64
+}
+
+fn mean_luminance(image: &[Vec3]) -> f64 {
+    image.iter().map(|&c| luminance(c) as f64).sum::<f64>() / image.len().max(1) as f64
+}
+
+/// The image's mean luminance over the reference's.
+pub fn energy_ratio(image: &[Vec3], reference: &[Vec3]) -> f64 {
+    check_sizes(image, reference);
+    mean_luminance(image) / mean_luminance(reference)
+}
+
+/// Temporal flicker: the mean absolute luminance change between two consecutive frames of a
+/// static camera, relative to the reference's mean luminance.
+pub fn flicker(previous: &[Vec3], current: &[Vec3], reference: &[Vec3]) -> f64 {
+    check_sizes(previous, current);
+    let change: f64 = previous
+        .iter()
+        .zip(current)
+        .map(|(a, b)| (luminance(*a) - luminance(*b)).abs() as f64)
+        .sum::<f64>()
+        / current.len().max(1) as f64;
+    change / mean_luminance(reference)
+}
+
+/// The median (the mean of the two middle values for an even count).
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// The q-quantile (0..=1) of `values` by the nearest-rank method.
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
+}
