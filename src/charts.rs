@@ -180,10 +180,10 @@ pub fn write_image_strip(path: &Path, width: u32, height: u32, panels: &[StripPa
         for y in 0..ph {
             for x in 0..pw {
                 let (sx, sy) = (x / scale, y / scale);
-                let inside = sx >= inset.x && sx < inset.x + inset.size && sy >= inset.y && sy < inset.y + inset.size;
-                let edge = inside
-                    && (x / scale == inset.x || x / scale == inset.x + inset.size - 1 || y / scale == inset.y || y / scale == inset.y + inset.size - 1)
-                    && (x % scale == 0 || y % scale == 0);
+                let (lo_x, lo_y) = (inset.x * scale, inset.y * scale);
+                let (hi_x, hi_y) = (lo_x + inset.size * scale - 1, lo_y + inset.size * scale - 1);
+                let inside = (lo_x..=hi_x).contains(&x) && (lo_y..=hi_y).contains(&y);
+                let edge = inside && (x == lo_x || x == hi_x || y == lo_y || y == hi_y);
                 put(x0 + x, LABEL_HEIGHT + y, if edge { [255, 40, 40] } else { colour(sx, sy) });
             }
         }
