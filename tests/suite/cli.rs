@@ -247,15 +247,14 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
     assert_clean_failure(&["render", "--m-cap", "NaN"], &["--m-cap"]);
 }
 
-#[test]
-fn cli_reference_and_profile_write_their_files() {
-    let dir = temp_file("placeholder", b"").parent().unwrap().join("reference-profile");
+/// `restir-pt reference` of cornell at 16x16 into `dir/ref.exr`.
+fn reference_16x16(dir: &std::path::Path, spp: u32) -> std::path::PathBuf {
     let reference = dir.join("ref.exr");
     let (code, _, stderr) = restir_pt(&[
         "reference",
         "scenes/cornell.gltf",
         "--spp",
-        "8",
+        &spp.to_string(),
         "--width",
         "16",
         "--height",
@@ -264,7 +263,14 @@ fn cli_reference_and_profile_write_their_files() {
         reference.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{stderr}");
-    assert!(reference.exists() && dir.join("ref.variance.exr").exists(), "{stderr}");
+    reference
+}
+
+#[test]
+fn cli_reference_and_profile_write_their_files() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().join("reference-profile");
+    let reference = reference_16x16(&dir, 8);
+    assert!(reference.exists() && dir.join("ref.variance.exr").exists());
 
     let (code, stdout, stderr) = restir_pt(&[
         "profile",
@@ -291,20 +297,7 @@ fn cli_reference_and_profile_write_their_files() {
 #[test]
 fn cli_compare_writes_results_charts_and_strip() {
     let dir = temp_file("placeholder", b"").parent().unwrap().join("compare");
-    let reference = dir.join("ref.exr");
-    let (code, _, stderr) = restir_pt(&[
-        "reference",
-        "scenes/cornell.gltf",
-        "--spp",
-        "64",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--out",
-        reference.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{stderr}");
+    let reference = reference_16x16(&dir, 64);
     let budgets = ["1000", "2000"];
     let (code, stdout, stderr) = restir_pt(&[
         "compare",
