@@ -1,9 +1,9 @@
 // Initial candidates of ReSTIR PT: one traced path from the pixel's primary hit offers every
-// prefix that ends on a light, by NEE at a vertex or by a BSDF-sampled hit right after a delta
-// lobe. These two end types partition the paths (NEE cannot reach past a delta lobe, and a BSDF
-// hit after a non-delta lobe is left to NEE), so each path has exactly one way to be offered and
-// needs no further MIS weight; the shifts keep the lobe before the end, hence the partition.
-// The paths are built with the steps generate_path() in shift.glsl regenerates them with
+// prefix that ends on a light, by NEE at a vertex or by a BSDF-sampled hit. A path either
+// technique can make is offered by both, each weighted by the balance heuristic
+// (end_mis_weight in shift.glsl): the two weighted integrands sum to the path's, and each is a
+// function of the path that the shifts evaluate anew (the end type travels in the record). The
+// paths are built with the steps generate_path() in shift.glsl regenerates them with
 // (nee_vertex, bsdf_vertex).
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
@@ -61,7 +61,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
                 q.vertices[i] = light;
                 q.lobes[i - 1u] = LOBE_NONE;
                 q.weights[i - 1u] = f_cos / ls.pdf;
-                q.contribution = prefix * q.weights[i - 1u] * end_emission(x, light);
+                q.contribution = prefix * q.weights[i - 1u] * end_emission(x, light) * end_mis_weight(x, prev_pos, light, true, false);
                 if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.x);
             }
         }
@@ -74,13 +74,11 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         p.vertices[i] = next;
         p.count = i + 1u;
         prefix *= b.weight;
-        if ((b.lobe & LOBE_DELTA) != 0u) {
-            vec3 c = prefix * end_emission(x, next);
-            if (max_component(c) > 0.0) {
-                Path q = p;
-                q.contribution = c;
-                offer_candidate(s, q, params, scale, u.y);
-            }
+        vec3 emitted = end_emission(x, next);
+        if (max_component(emitted) > 0.0) {
+            Path q = p;
+            q.contribution = prefix * emitted * end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
+            if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.y);
         }
         prev_pos = x.pos;
     }

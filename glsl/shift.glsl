@@ -109,6 +109,21 @@ float light_pdf(Vertex from, Vertex end) {
     return vertex_is_escaped(end) ? environment_pdf() : emitter_pdf(end.triangle, dir, dist);
 }
 
+// Balance-heuristic weight of the technique that ended a path at `end` from `x` (reached from
+// `before`): NEE (`nee_end`) or BSDF sampling. Both are evaluated from the vertices, so a shifted
+// path gets its own weight. After a delta lobe only BSDF sampling reaches the end: weight 1.
+float end_mis_weight(Vertex x, vec3 before, Vertex end, bool nee_end, bool after_delta) {
+    if (after_delta) return nee_end ? 0.0 : 1.0;
+    vec3 dir;
+    float dist;
+    direction(x, end, dir, dist);
+    float bsdf_pdf;
+    bsdf_eval_pdf(material_of(x), x.normal, normalize(before - x.pos), dir, bsdf_pdf);
+    float light = light_pdf(x, end);
+    float own = nee_end ? light : bsdf_pdf;
+    return own > 0.0 ? own / (light + bsdf_pdf) : 0.0;
+}
+
 Vertex hit_vertex(Hit hit) {
     Triangle t = triangles[hit.triangle];
     return vertex_on_surface(hit.triangle, t.v0 + hit.bary.x * t.e1 + hit.bary.y * t.e2);
@@ -178,7 +193,13 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
 bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
     if (!trace_vertices(camera, x1, seed, target_length, nee_end, path)) return false;
     uint k = path.count;
-    vec3 c = k >= 2u ? end_emission(path.vertices[k - 2u], path.vertices[k - 1u]) : vec3(0.0);
+    vec3 c = vec3(0.0);
+    if (k >= 2u) {
+        vec3 before = k >= 3u ? path.vertices[k - 3u].pos : camera;
+        bool after_delta = (path.lobes[k - 2u] & LOBE_DELTA) != 0u;
+        c = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]) *
+            end_mis_weight(path.vertices[k - 2u], before, path.vertices[k - 1u], nee_end, after_delta);
+    }
     for (uint i = 0u; i + 1u < k; ++i) {
         loop_tick();
         c *= path.weights[i];
@@ -235,7 +256,8 @@ bool join_at_reconnection(PathRecord base, Vertex prev, vec3 before, Vertex x_r,
     vec3 weight = prefix_weight * link.f_cos / link.pdf;
     vec3 contribution;
     if (r == k) {
-        contribution = weight * end_emission(prev, x_r);
+        bool after_delta = (record_lobe(base, k - 1u) & LOBE_DELTA) != 0u;
+        contribution = weight * end_emission(prev, x_r) * end_mis_weight(prev, before, x_r, record_nee_end(base), after_delta);
     } else {
         Vertex x_next = record_vertex(base.rc_next_triangle, base.rc_next);
         bool next_is_nee = r + 1u == k && record_nee_end(base);
@@ -248,6 +270,9 @@ bool join_at_reconnection(PathRecord base, Vertex prev, vec3 before, Vertex x_r,
             pdf_after_x_r = q;
         }
         contribution = weight * f_r / q * base.suffix;
+        // The suffix holds the end's MIS weight unless x_r is the last scattering vertex, whose
+        // incoming direction the join changes.
+        if (r + 1u == k) contribution *= end_mis_weight(x_r, prev.pos, x_next, record_nee_end(base), false);
     }
     if (!(max_component(contribution) > 0.0)) return false;
     record.contribution = contribution;
@@ -283,6 +308,10 @@ bool record_path(Path path, ShiftParams params, out PathRecord record) {
         record.rc_next = x_next.pos;
         record.rc_next_triangle = x_next.triangle;
         vec3 s = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]);
+        if (r + 1u < k) {
+            bool after_delta = (path.lobes[k - 2u] & LOBE_DELTA) != 0u;
+            s *= end_mis_weight(path.vertices[k - 2u], path.vertices[k - 3u].pos, path.vertices[k - 1u], path.nee_end, after_delta);
+        }
         for (uint i = r; i + 1u < k; ++i) {
             loop_tick();
             s *= path.weights[i];

@@ -208,6 +208,24 @@ fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
     }
 }
 
+/// Balance-heuristic weight of the technique that ended a path at `end` from `x` (reached from
+/// `before`): NEE (`nee_end`) or BSDF sampling, evaluated from the vertices so that a shifted
+/// path gets its own weight. After a delta lobe only BSDF sampling reaches the end: weight 1.
+pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee_end: bool, after_delta: bool) -> f32 {
+    if after_delta {
+        return if nee_end { 0.0 } else { 1.0 };
+    }
+    let (dir, _) = direction(x, end);
+    let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, (before - x.pos).normalize(), dir);
+    let light = light_pdf(scene, x, end);
+    let own = if nee_end { light } else { bsdf_pdf };
+    if own > 0.0 {
+        own / (light + bsdf_pdf)
+    } else {
+        0.0
+    }
+}
+
 /// Regenerates the path of `length` vertices from the primary hit `x1` seen from `camera`, with
 /// the random numbers of `seed`: BSDF sampling at x1..x_{k-2} and, at x_{k-1}, NEE when
 /// `nee_end`, else BSDF sampling. `None` if the path ends early (a miss, a failed sample, an
@@ -216,7 +234,10 @@ pub fn generate_path(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length:
     let mut path = trace_vertices(scene, camera, x1, seed, length, nee_end)?;
     let k = path.length();
     let emitted = if k >= 2 {
+        let before = if k >= 3 { path.vertices[k - 3].pos } else { camera };
+        let after_delta = path.lobes[k - 2] & LOBE_DELTA != 0;
         end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1])
+            * end_mis_weight(scene, &path.vertices[k - 2], before, &path.vertices[k - 1], nee_end, after_delta)
     } else {
         Vec3::ZERO
     };
@@ -320,7 +341,13 @@ pub fn record_path(scene: &Scene, params: &ShiftParams, path: &Path) -> Option<P
         let x_next = path.vertices[r];
         record.rc_next = x_next.pos.into();
         record.rc_next_triangle = x_next.triangle;
-        let emitted = end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1]);
+        let mut emitted = end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1]);
+        // The end's MIS weight belongs to the suffix unless x_r is the last scattering vertex,
+        // whose incoming direction a join changes.
+        if r + 1 < k {
+            let after_delta = path.lobes[k - 2] & LOBE_DELTA != 0;
+            emitted *= end_mis_weight(scene, &path.vertices[k - 2], path.vertices[k - 3].pos, &path.vertices[k - 1], path.nee_end, after_delta);
+        }
         record.suffix = path.weights[r..].iter().fold(emitted, |acc, &w| acc * w).into();
     }
     // The edges into and out of x_r are evaluated from the vertices, as every shift evaluates
@@ -370,7 +397,8 @@ fn join_at_reconnection(
     let weight = prefix_weight * link.f_cos / link.pdf;
     let mut pdf_after_x_r = None;
     let contribution = if r == k {
-        weight * end_emission(scene, prev, x_r)
+        let after_delta = base.lobe(k - 1) & LOBE_DELTA != 0;
+        weight * end_emission(scene, prev, x_r) * end_mis_weight(scene, prev, before, x_r, base.nee_end(), after_delta)
     } else {
         // x_r scatters towards x_{r+1} with this predecessor's incoming direction.
         let x_next = record_vertex(scene, base.rc_next_triangle, base.rc_next);
@@ -383,7 +411,12 @@ fn join_at_reconnection(
             record.rc_pdf_after = q;
             pdf_after_x_r = Some(q);
         }
-        weight * f_r / q * Vec3::from(base.suffix)
+        let end_weight = if r + 1 == k {
+            end_mis_weight(scene, x_r, prev.pos, &x_next, base.nee_end(), false)
+        } else {
+            1.0
+        };
+        weight * f_r / q * Vec3::from(base.suffix) * end_weight
     };
     if !(contribution.max_element() > 0.0) {
         return None;

@@ -4,7 +4,9 @@
 //! Unbiasedness: on 64x64 images with a moving camera (cameras 0, 1, 2: initial candidates,
 //! temporal reuse with reprojection and spatial reuse), the mean of 32 independent renders
 //! (fresh seeds, cleared history) is compared with a 4096-spp path-traced reference of camera
-//! 2: total energy within 1%, and per 8x8 block a two-sided Welch t-test at the 1% level.
+//! 2: total energy within 1%, and per 8x8 block a two-sided Welch t-test at the 1% level. A
+//! configuration fails if its energy is off or more blocks fail than chance allows at 1%
+//! (at most 3 of 64; see max_failing_blocks); the pass rate is printed against the 99% bar.
 
 use std::sync::atomic::AtomicBool;
 
@@ -104,6 +106,34 @@ fn restir_student_t_matches_tables() {
     assert!((student_t_two_sided(0.0, 10.0) - 1.0).abs() < 1e-9);
 }
 
+/// P(X >= k) for X ~ Binomial(n, p).
+fn binomial_tail(n: usize, p: f64, k: usize) -> f64 {
+    let mut term = (1.0 - p).powi(n as i32);
+    let mut below = 0.0;
+    for i in 0..k {
+        below += term;
+        term *= (n - i) as f64 / (i + 1) as f64 * p / (1.0 - p);
+    }
+    (1.0 - below).max(0.0)
+}
+
+/// The most failing blocks an unbiased renderer shows with 99% probability. Each block fails
+/// at the 1% level by chance alone, so with 64 blocks "at least 99% pass" (no failure at all)
+/// holds only with probability 0.99^64 = 53% for an exact renderer; the count of chance failures
+/// is Binomial(blocks, 1%), and more failures than this bound are evidence of bias at 1%.
+fn max_failing_blocks(blocks: usize) -> usize {
+    (0..blocks).find(|&k| binomial_tail(blocks, ALPHA, k + 1) < 0.01).expect("the tail vanishes")
+}
+
+#[test]
+fn restir_binomial_bound_on_chance_failures() {
+    assert!((binomial_tail(64, 0.01, 1) - (1.0 - 0.99f64.powi(64))).abs() < 1e-12);
+    assert!((binomial_tail(64, 0.01, 0) - 1.0).abs() < 1e-12);
+    // P(X >= 3) = 0.0265 and P(X >= 4) = 0.0040 for 64 blocks: at most 3 chance failures.
+    assert!((binomial_tail(64, 0.01, 4) - 0.0040).abs() < 1e-4);
+    assert_eq!(max_failing_blocks(64), 3);
+}
+
 /// Block means of luminance, and (for a path-traced image) the variance of each block mean.
 fn blocks(image: &Image) -> Vec<(f64, f64)> {
     let per_side = SIDE / BLOCK;
@@ -144,6 +174,7 @@ fn check_unbiased(name: &str) {
     let reference = reference(&ctx, &scene);
     let ref_blocks = blocks(&reference);
     let ref_energy: f64 = ref_blocks.iter().map(|b| b.0).sum();
+    let max_failing = max_failing_blocks(ref_blocks.len());
     let mut failures = vec![];
     for shift in [ShiftKind::Reconnection, ShiftKind::Replay, ShiftKind::Hybrid] {
         for mis in [ReuseMis::GeneralizedBalance, ReuseMis::Pairwise] {
@@ -168,6 +199,7 @@ fn check_unbiased(name: &str) {
             }
             let n = RENDERS as f64;
             let mut passed = 0;
+            let mut failing_t = vec![];
             let mut energy = 0.0;
             for (s, r) in sums.iter().zip(&ref_blocks) {
                 let mean = s.0 / n;
@@ -182,6 +214,8 @@ fn check_unbiased(name: &str) {
                 let t = if se2 > 0.0 { (mean - r.0) / se2.sqrt() } else { 0.0 };
                 if student_t_two_sided(t.abs(), dof) >= ALPHA {
                     passed += 1;
+                } else {
+                    failing_t.push(format!("{t:.2}"));
                 }
             }
             let pass_rate = passed as f64 / ref_blocks.len() as f64;
@@ -189,13 +223,13 @@ fn check_unbiased(name: &str) {
             let energy_var = energies.iter().map(|e| (e - energy_ratio).powi(2)).sum::<f64>() / (n - 1.0);
             let energy_se = (energy_var / n).sqrt();
             println!(
-                "{name} {}: energy ratio {energy_ratio:.4} (standard error {energy_se:.4}), blocks passing {passed}/{} ({:.1}%), failed shifts {:.1}%",
+                "{name} {}: energy ratio {energy_ratio:.4} (standard error {energy_se:.4}), blocks passing {passed}/{} ({:.1}%; failing t: {failing_t:?}), failed shifts {:.1}%",
                 restir.label(),
                 ref_blocks.len(),
                 100.0 * pass_rate,
                 100.0 * failed_rate
             );
-            if (energy_ratio - 1.0).abs() > 0.01 || pass_rate < 0.99 {
+            if (energy_ratio - 1.0).abs() > 0.01 || failing_t.len() > max_failing {
                 failures.push(format!(
                     "{} (energy {energy_ratio:.4}, blocks {passed}/{})",
                     restir.label(),
