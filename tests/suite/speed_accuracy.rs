@@ -25,8 +25,8 @@ fn metrics_rel_mse_energy_and_flicker_match_hand_values() {
 /// moving camera, each frame against a 256-spp reference of its pose. No pixel may be
 /// non-finite, and the energy averaged over a run's frames must be within 2% of 1. This is a
 /// check for NaNs and lost or runaway energy, not a precise bias test (restir_unbiased_cornell
-/// is): ReSTIR PT's run means over seeds 0 to 8 were 0.980 to 1.028 (SD 1.3%), so about one seed
-/// in seven would miss 2%. The seed is fixed, so the test is deterministic.
+/// is): ReSTIR PT's run means over seeds 0 to 7 were 0.980 to 1.028 (mean 1.000, SD 1.3%), so
+/// about one seed in seven would miss 2%. The seed is fixed, so the test is deterministic.
 #[test]
 fn stability_small_run_is_finite_and_keeps_energy_within_2_percent() {
     let out = temp_file("placeholder", b"").parent().unwrap().join("stability");
