@@ -39,6 +39,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
     p.nee_end = false;
     p.vertices[0] = y1;
     p.contribution = vec3(0.0);
+    p.end_weight = 0.0;
     vec3 prefix = vec3(1.0);
     vec3 prev_pos = camera;
     for (uint i = 1u; i < max_length; ++i) {
@@ -61,7 +62,8 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
                 q.vertices[i] = light;
                 q.lobes[i - 1u] = LOBE_NONE;
                 q.weights[i - 1u] = f_cos / ls.pdf;
-                q.contribution = prefix * q.weights[i - 1u] * end_emission(x, light) * end_mis_weight(x, prev_pos, light, true, false);
+                q.end_weight = end_mis_weight(x, prev_pos, light, true, false);
+                q.contribution = prefix * q.weights[i - 1u] * end_emission(x, light) * q.end_weight;
                 if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.x);
             }
         }
@@ -77,7 +79,8 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         vec3 emitted = end_emission(x, next);
         if (max_component(emitted) > 0.0) {
             Path q = p;
-            q.contribution = prefix * emitted * end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
+            q.end_weight = end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
+            q.contribution = prefix * emitted * q.end_weight;
             if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.y);
         }
         prev_pos = x.pos;

@@ -33,6 +33,7 @@ struct Path {
     uint lobes[MAX_PATH_LENGTH];       // the lobe sampled at x_i is lobes[i - 1]
     vec3 weights[MAX_PATH_LENGTH];     // f_s |cos| / p at x_i is weights[i - 1]
     vec3 contribution;
+    float end_weight;                  // end_mis_weight of the technique that made x_k
 };
 
 struct ShiftResult {
@@ -157,6 +158,7 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
     path.nee_end = nee_end;
     path.vertices[0] = x1;
     path.contribution = vec3(0.0);
+    path.end_weight = 0.0;
     vec3 prev_pos = camera;
     while (path.count < target_length) {
         loop_tick();
@@ -197,8 +199,8 @@ bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool n
     if (k >= 2u) {
         vec3 before = k >= 3u ? path.vertices[k - 3u].pos : camera;
         bool after_delta = (path.lobes[k - 2u] & LOBE_DELTA) != 0u;
-        c = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]) *
-            end_mis_weight(path.vertices[k - 2u], before, path.vertices[k - 1u], nee_end, after_delta);
+        path.end_weight = end_mis_weight(path.vertices[k - 2u], before, path.vertices[k - 1u], nee_end, after_delta);
+        c = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]) * path.end_weight;
     }
     for (uint i = 0u; i + 1u < k; ++i) {
         loop_tick();
@@ -308,10 +310,7 @@ bool record_path(Path path, ShiftParams params, out PathRecord record) {
         record.rc_next = x_next.pos;
         record.rc_next_triangle = x_next.triangle;
         vec3 s = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]);
-        if (r + 1u < k) {
-            bool after_delta = (path.lobes[k - 2u] & LOBE_DELTA) != 0u;
-            s *= end_mis_weight(path.vertices[k - 2u], path.vertices[k - 3u].pos, path.vertices[k - 1u], path.nee_end, after_delta);
-        }
+        if (r + 1u < k) s *= path.end_weight;
         for (uint i = r; i + 1u < k; ++i) {
             loop_tick();
             s *= path.weights[i];

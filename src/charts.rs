@@ -21,7 +21,8 @@ fn register_font() -> Result<()> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
-            let bytes = std::fs::read(FONT_FILE).map_err(|e| format!("{FONT_FILE}: cannot read the chart font ({e}); install fonts-dejavu-core (tools/setup.sh)"))?;
+            let bytes = std::fs::read(FONT_FILE)
+                .map_err(|e| format!("{FONT_FILE}: cannot read the chart font ({e}); install fonts-dejavu-core (tools/setup.sh)"))?;
             plotters::style::register_font(FONT, FontStyle::Normal, Box::leak(bytes.into_boxed_slice()))
                 .map_err(|_| format!("{FONT_FILE}: not a usable TrueType font"))
         })
@@ -197,8 +198,12 @@ pub fn write_image_strip(path: &Path, width: u32, height: u32, panels: &[StripPa
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         for (p, panel) in panels.iter().enumerate() {
-            root.draw(&Text::new(panel.label.clone(), (p as i32 * pw as i32 + 6, 4), (FONT, 15).into_font().color(&BLACK)))
-                .map_err(|e| anyhow!("{}: drawing a label: {e}", path.display()))?;
+            root.draw(&Text::new(
+                panel.label.clone(),
+                (p as i32 * pw as i32 + 6, 4),
+                (FONT, 15).into_font().color(&BLACK),
+            ))
+            .map_err(|e| anyhow!("{}: drawing a label: {e}", path.display()))?;
         }
         root.present().map_err(|e| anyhow!("{}: {e}", path.display()))?;
     }

@@ -13,18 +13,16 @@ fn check_sizes(image: &[Vec3], reference: &[Vec3]) {
     assert_eq!(image.len(), reference.len(), "an image and its reference differ in size");
 }
 
+/// One pixel's (x - r)^2 / (r^2 + 1e-2), summed over its channels.
+pub fn rel_squared_error(x: Vec3, r: Vec3) -> f64 {
+    let d = x - r;
+    (d * d / (r * r + Vec3::splat(REL_MSE_EPSILON))).element_sum() as f64
+}
+
 /// Mean over pixels and channels of (x - r)^2 / (r^2 + 1e-2), accumulated in f64.
 pub fn rel_mse(image: &[Vec3], reference: &[Vec3]) -> f64 {
     check_sizes(image, reference);
-    let sum: f64 = image
-        .iter()
-        .zip(reference)
-        .map(|(x, r)| {
-            let d = *x - *r;
-            let rel = d * d / (*r * *r + Vec3::splat(REL_MSE_EPSILON));
-            (rel.x + rel.y + rel.z) as f64
-        })
-        .sum();
+    let sum: f64 = image.iter().zip(reference).map(|(x, r)| rel_squared_error(*x, *r)).sum();
     sum / (3 * image.len().max(1)) as f64
 }
 
@@ -56,6 +54,16 @@ pub fn flicker(previous: &[Vec3], current: &[Vec3], reference: &[Vec3]) -> f64 {
         .sum::<f64>()
         / current.len().max(1) as f64;
     change / mean_luminance(reference)
+}
+
+/// The arithmetic mean; NaN for no values.
+pub fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        sum / n as f64
+    }
 }
 
 /// The median (the mean of the two middle values for an even count).

@@ -88,6 +88,8 @@ pub struct Path {
     pub weights: Vec<Vec3>,
     /// f(X); zero if the end emits nothing towards x_{k-1}.
     pub contribution: Vec3,
+    /// `end_mis_weight` of the technique that made x_k, as `generate_path` evaluated it.
+    pub end_weight: f32,
 }
 
 impl Path {
@@ -236,8 +238,8 @@ pub fn generate_path(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length:
     let emitted = if k >= 2 {
         let before = if k >= 3 { path.vertices[k - 3].pos } else { camera };
         let after_delta = path.lobes[k - 2] & LOBE_DELTA != 0;
-        end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1])
-            * end_mis_weight(scene, &path.vertices[k - 2], before, &path.vertices[k - 1], nee_end, after_delta)
+        path.end_weight = end_mis_weight(scene, &path.vertices[k - 2], before, &path.vertices[k - 1], nee_end, after_delta);
+        end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1]) * path.end_weight
     } else {
         Vec3::ZERO
     };
@@ -255,6 +257,7 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
         lobes: Vec::new(),
         weights: Vec::new(),
         contribution: Vec3::ZERO,
+        end_weight: 0.0,
     };
     let mut prev_pos = camera;
     while path.length() < length {
@@ -345,8 +348,7 @@ pub fn record_path(scene: &Scene, params: &ShiftParams, path: &Path) -> Option<P
         // The end's MIS weight belongs to the suffix unless x_r is the last scattering vertex,
         // whose incoming direction a join changes.
         if r + 1 < k {
-            let after_delta = path.lobes[k - 2] & LOBE_DELTA != 0;
-            emitted *= end_mis_weight(scene, &path.vertices[k - 2], path.vertices[k - 3].pos, &path.vertices[k - 1], path.nee_end, after_delta);
+            emitted *= path.end_weight;
         }
         record.suffix = path.weights[r..].iter().fold(emitted, |acc, &w| acc * w).into();
     }

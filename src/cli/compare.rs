@@ -12,7 +12,7 @@ use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
 use crate::image_io::read_exr;
-use crate::metrics::{energy_ratio, median, mse, rel_mse};
+use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_squared_error};
 use crate::render::{Image, RenderSettings, RestirSettings, MAX_CANDIDATES};
 use crate::scene::Scene;
 
@@ -143,14 +143,17 @@ fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> 
     let size = (width.min(height) / 4).max(4).min(width.min(height));
     let error = |x: u32, y: u32| {
         let i = (y * width + x) as usize;
-        let d = image[i] - reference[i];
-        (d * d / (reference[i] * reference[i] + Vec3::splat(1e-2))).element_sum() as f64
+        rel_squared_error(image[i], reference[i])
     };
     let mut best = (f64::NEG_INFINITY, Inset { x: 0, y: 0, size });
     let step = (size / 2).max(1);
     for y in (0..=height - size).step_by(step as usize) {
         for x in (0..=width - size).step_by(step as usize) {
-            let e: f64 = (y..y + size).flat_map(|yy| (x..x + size).map(move |xx| (xx, yy))).map(|(xx, yy)| error(xx, yy)).filter(|e| e.is_finite()).sum();
+            let e: f64 = (y..y + size)
+                .flat_map(|yy| (x..x + size).map(move |xx| (xx, yy)))
+                .map(|(xx, yy)| error(xx, yy))
+                .filter(|e| e.is_finite())
+                .sum();
             if e > best.0 {
                 best = (e, Inset { x, y, size });
             }
@@ -191,7 +194,12 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     let scene = load_with_warnings(&path)?;
     let (width, height, reference) = read_exr(&args.reference)?;
     if let Some(i) = reference.iter().position(|p| !p.is_finite()) {
-        bail!("{}: the reference has a non-finite pixel ({}, {})", args.reference.display(), i as u32 % width, i as u32 / width);
+        bail!(
+            "{}: the reference has a non-finite pixel ({}, {})",
+            args.reference.display(),
+            i as u32 % width,
+            i as u32 / width
+        );
     }
     let methods = parse_methods(&args.methods, &args.restir)?;
     let settings = RenderSettings {
@@ -229,7 +237,11 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
                 Cost::PerSample(_) => None,
             })
             .fold(f64::INFINITY, f64::min);
-        let unit = if cheapest_restir.is_finite() { cheapest_restir * 1.05 } else { 10.0 };
+        let unit = if cheapest_restir.is_finite() {
+            cheapest_restir * 1.05
+        } else {
+            10.0
+        };
         vec![unit, 2.0 * unit, 4.0 * unit]
     } else {
         args.budgets_ms.clone()
@@ -276,7 +288,9 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
                 row.rel_mse,
                 row.mse,
                 row.energy_ratio,
-                row.failed_shift_rate.map(|f| format!(" | failed shifts {:.2}%", 100.0 * f)).unwrap_or_default()
+                row.failed_shift_rate
+                    .map(|f| format!(" | failed shifts {:.2}%", 100.0 * f))
+                    .unwrap_or_default()
             );
             images.push((label.clone(), budget, last.expect("at least one trial")));
             rows.push(row);
@@ -287,13 +301,27 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     report_equal_time(&rows, &budgets);
 
     write_csv(&args.out_dir.join("results.csv"), &rows)?;
-    let title = format!("{} {}x{}, frame {} of a static camera, {}", path.display(), width, height, args.frames, ctx.info.name);
-    for (metric, name, value) in [("rel_mse", "relMSE", (|r: &CompareRow| r.rel_mse) as fn(&CompareRow) -> f64), ("mse", "MSE", |r| r.mse)] {
+    let title = format!(
+        "{} {}x{}, frame {} of a static camera, {}",
+        path.display(),
+        width,
+        height,
+        args.frames,
+        ctx.info.name
+    );
+    for (metric, name, value) in [
+        ("rel_mse", "relMSE", (|r: &CompareRow| r.rel_mse) as fn(&CompareRow) -> f64),
+        ("mse", "MSE", |r| r.mse),
+    ] {
         let series: Vec<Series> = methods
             .iter()
             .map(|m| Series {
                 name: m.label(),
-                points: rows.iter().filter(|r| r.method == m.label()).map(|r| (r.gpu_ms_per_frame, value(r))).collect(),
+                points: rows
+                    .iter()
+                    .filter(|r| r.method == m.label())
+                    .map(|r| (r.gpu_ms_per_frame, value(r)))
+                    .collect(),
             })
             .collect();
         write_line_chart(
@@ -307,8 +335,19 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
             },
         )?;
     }
-    write_strip(&args.out_dir.join("equal_time.png"), &budgets, &methods, &images, &reference, width, height)?;
-    eprintln!("wrote results.csv, rel_mse_vs_time.svg/png, mse_vs_time.svg/png and equal_time.png in {}", args.out_dir.display());
+    write_strip(
+        &args.out_dir.join("equal_time.png"),
+        &budgets,
+        &methods,
+        &images,
+        &reference,
+        width,
+        height,
+    )?;
+    eprintln!(
+        "wrote results.csv, rel_mse_vs_time.svg/png, mse_vs_time.svg/png and equal_time.png in {}",
+        args.out_dir.display()
+    );
     Ok(rows)
 }
 
@@ -316,7 +355,11 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
 /// the best ReSTIR PT method's.
 fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
     for &budget in budgets {
-        let at = |pred: &dyn Fn(&CompareRow) -> bool| rows.iter().filter(|r| r.budget_ms == budget && pred(r)).min_by(|a, b| a.rel_mse.total_cmp(&b.rel_mse));
+        let at = |pred: &dyn Fn(&CompareRow) -> bool| {
+            rows.iter()
+                .filter(|r| r.budget_ms == budget && pred(r))
+                .min_by(|a, b| a.rel_mse.total_cmp(&b.rel_mse))
+        };
         if let (Some(pt), Some(best)) = (at(&|r| r.method == "pt"), at(&|r| r.method != "pt")) {
             println!(
                 "equal time {budget:.1} ms: pt relMSE {:.4e} ({:.1} ms) / {} relMSE {:.4e} ({:.1} ms) = {:.2}x",
@@ -332,9 +375,18 @@ fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
 }
 
 /// The strip of the largest budget every method fit (or the largest budget run at all).
-fn write_strip(path: &Path, budgets: &[f64], methods: &[MethodSpec], images: &[(String, f64, Image)], reference: &[Vec3], width: u32, height: u32) -> Result<()> {
+fn write_strip(
+    path: &Path,
+    budgets: &[f64],
+    methods: &[MethodSpec],
+    images: &[(String, f64, Image)],
+    reference: &[Vec3],
+    width: u32,
+    height: u32,
+) -> Result<()> {
     let complete = |b: f64| methods.iter().all(|m| images.iter().any(|(l, ib, _)| *l == m.label() && *ib == b));
-    let Some(budget) = budgets.iter().copied().filter(|&b| complete(b)).fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b)))).or_else(|| images.iter().map(|i| i.1).reduce(f64::max)) else {
+    let largest_complete = budgets.iter().copied().filter(|&b| complete(b)).reduce(f64::max);
+    let Some(budget) = largest_complete.or_else(|| images.iter().map(|i| i.1).reduce(f64::max)) else {
         return Ok(());
     };
     let chosen: Vec<&(String, f64, Image)> = images.iter().filter(|i| i.1 == budget).collect();

@@ -71,9 +71,10 @@ pub fn parse_methods(list: &[String], base: &RestirSettings) -> Result<Vec<Metho
 
 /// A compiled renderer for one method; its kernels are reused across runs.
 pub enum MethodRenderer {
-    /// The path tracer and its paths per pixel and frame.
-    PathTracing(PathTracer, u32),
-    Restir(Restir),
+    /// The path tracer and its paths per pixel and frame. Both renderers are boxed: each holds
+    /// over a kilobyte of handles.
+    PathTracing(Box<PathTracer>, u32),
+    Restir(Box<Restir>),
 }
 
 /// What one frame cost and how its shifts went.
@@ -86,8 +87,8 @@ pub struct FrameOutcome {
 impl MethodRenderer {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, method: &MethodSpec) -> Result<Self> {
         Ok(match method {
-            MethodSpec::PathTracing => MethodRenderer::PathTracing(PathTracer::new(ctx, scene, settings)?, settings.spp),
-            MethodSpec::Restir(r) => MethodRenderer::Restir(Restir::new(ctx, scene, settings, r)?),
+            MethodSpec::PathTracing => MethodRenderer::PathTracing(Box::new(PathTracer::new(ctx, scene, settings)?), settings.spp),
+            MethodSpec::Restir(r) => MethodRenderer::Restir(Box::new(Restir::new(ctx, scene, settings, r)?)),
         })
     }
 

@@ -34,18 +34,21 @@ pub struct DeviceArgs {
     pub validate: bool,
 }
 
-/// The scene to load: the given path, or the bundled Cornell box next to the crate.
+/// The scene to load: the given path, or the bundled Cornell box.
 pub fn scene_path(scene: Option<&Path>) -> PathBuf {
     match scene {
         Some(p) => p.to_path_buf(),
-        None => {
-            let local = PathBuf::from(DEFAULT_SCENE);
-            if local.exists() {
-                local
-            } else {
-                Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_SCENE)
-            }
-        }
+        None => bundled_file(Path::new(DEFAULT_SCENE)),
+    }
+}
+
+/// A file shipped with the crate (`relative` to its root): from the working folder if it has
+/// one, else next to the crate.
+pub fn bundled_file(relative: &Path) -> PathBuf {
+    if relative.exists() {
+        relative.to_path_buf()
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
     }
 }
 

@@ -12,9 +12,9 @@ use anyhow::{bail, Context as _, Result};
 use glam::Vec3;
 
 use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
-use super::{finish_device, load_with_warnings, open_device, DeviceArgs};
+use super::{bundled_file, finish_device, load_with_warnings, open_device, DeviceArgs};
 use crate::charts::{write_line_chart, LineChart, Series};
-use crate::metrics::{energy_ratio, flicker, rel_mse};
+use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
 use crate::render::{PathTracer, RenderSettings, RestirSettings};
 use crate::scene::Scene;
 
@@ -105,21 +105,16 @@ impl References<'_> {
 }
 
 fn scene_name(path: &Path) -> String {
-    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
 }
 
-/// The bundled scenes next to the crate, in their documented order.
+/// The bundled scenes, in their documented order.
 pub fn bundled_scene_paths() -> Vec<PathBuf> {
     crate::bundled_scenes::BUNDLED_SCENES
         .iter()
-        .map(|s| {
-            let local = Path::new("scenes").join(s.file_name);
-            if local.exists() {
-                local
-            } else {
-                Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(s.file_name)
-            }
-        })
+        .map(|s| bundled_file(&Path::new("scenes").join(s.file_name)))
         .collect()
 }
 
@@ -131,8 +126,15 @@ pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
         bail!("--reference-spp and --pt-spp must be at least 1");
     }
     let methods = parse_methods(&args.methods, &args.restir)?;
-    let scenes = if args.scenes.is_empty() { bundled_scene_paths() } else { args.scenes.clone() };
-    let loaded: Vec<(PathBuf, Scene)> = scenes.iter().map(|p| Ok((p.clone(), load_with_warnings(p)?))).collect::<Result<_>>()?;
+    let scenes = if args.scenes.is_empty() {
+        bundled_scene_paths()
+    } else {
+        args.scenes.clone()
+    };
+    let loaded: Vec<(PathBuf, Scene)> = scenes
+        .iter()
+        .map(|p| Ok((p.clone(), load_with_warnings(p)?)))
+        .collect::<Result<_>>()?;
     let base = RenderSettings {
         width: args.width,
         height: args.height,
@@ -217,15 +219,6 @@ pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
     Ok(rows)
 }
 
-fn mean(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    if n == 0 {
-        f64::NAN
-    } else {
-        sum / n as f64
-    }
-}
-
 /// One line per method and camera motion.
 fn print_summary(rows: &[StabilityRow], methods: &[MethodSpec]) {
     for m in methods {
@@ -233,7 +226,9 @@ fn print_summary(rows: &[StabilityRow], methods: &[MethodSpec]) {
             let run: Vec<&StabilityRow> = rows.iter().filter(|r| r.method == m.label() && r.motion == motion).collect();
             let Some(last) = run.last() else { continue };
             let energies = run.iter().map(|r| r.energy_ratio);
-            let (lo, hi) = energies.clone().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| (lo.min(e), hi.max(e)));
+            let (lo, hi) = energies
+                .clone()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| (lo.min(e), hi.max(e)));
             let flicker = mean(run.iter().filter_map(|r| r.flicker));
             let failed = mean(run.iter().filter_map(|r| r.failed_shift_rate));
             println!(
@@ -245,8 +240,16 @@ fn print_summary(rows: &[StabilityRow], methods: &[MethodSpec]) {
                 mean(energies),
                 last.rel_mse,
                 mean(run.iter().map(|r| r.rel_mse)),
-                if flicker.is_nan() { String::new() } else { format!(" | flicker {flicker:.4}") },
-                if failed.is_nan() { String::new() } else { format!(" | failed shifts {:.2}%", 100.0 * failed) }
+                if flicker.is_nan() {
+                    String::new()
+                } else {
+                    format!(" | flicker {flicker:.4}")
+                },
+                if failed.is_nan() {
+                    String::new()
+                } else {
+                    format!(" | failed shifts {:.2}%", 100.0 * failed)
+                }
             );
         }
     }

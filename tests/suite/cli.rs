@@ -335,11 +335,24 @@ fn cli_compare_writes_results_charts_and_strip() {
     assert!(std::fs::read(dir.join("equal_time.png")).unwrap().starts_with(b"\x89PNG"));
 
     assert_clean_failure(
-        &["compare", "scenes/cornell.gltf", "--reference", reference.to_str().unwrap(), "--methods", "pt,restir:sideways"],
+        &[
+            "compare",
+            "scenes/cornell.gltf",
+            "--reference",
+            reference.to_str().unwrap(),
+            "--methods",
+            "pt,restir:sideways",
+        ],
         &["restir:sideways", "unknown shift"],
     );
     assert_clean_failure(
-        &["compare", "scenes/cornell.gltf", "--reference", reference.to_str().unwrap(), "--budgets-ms=0"],
+        &[
+            "compare",
+            "scenes/cornell.gltf",
+            "--reference",
+            reference.to_str().unwrap(),
+            "--budgets-ms=0",
+        ],
         &["--budgets-ms 0"],
     );
     assert_clean_failure(&["compare", "scenes/cornell.gltf", "--reference", "missing.exr"], &["missing.exr"]);

@@ -163,12 +163,19 @@ fn gris_toy_resampled_expectation_is_unbiased_with_lower_variance() {
             "GRIS toy {mis:?} g: expectation {mean:.5} (SE {se:.1e}), selection {selected_mean:.5} (SE {selected_se:.1e}), exact {:.5}",
             exact_g()
         );
-        assert!((mean - exact_g()).abs() / se < 4.0, "{mis:?}: expectation {mean} vs {} (SE {se})", exact_g());
+        assert!(
+            (mean - exact_g()).abs() / se < 4.0,
+            "{mis:?}: expectation {mean} vs {} (SE {se})",
+            exact_g()
+        );
         assert!(
             (selected_mean - exact_g()).abs() / selected_se < 4.0,
             "{mis:?}: selection {selected_mean} vs {} (SE {selected_se})",
             exact_g()
         );
-        assert!(se < selected_se, "{mis:?}: the expectation's SE {se} is not below the selection's {selected_se}");
+        assert!(
+            se < selected_se,
+            "{mis:?}: the expectation's SE {se} is not below the selection's {selected_se}"
+        );
     }
 }

@@ -122,7 +122,9 @@ fn binomial_tail(n: usize, p: f64, k: usize) -> f64 {
 /// holds only with probability 0.99^64 = 53% for an exact renderer; the count of chance failures
 /// is Binomial(blocks, 1%), and more failures than this bound are evidence of bias at 1%.
 fn max_failing_blocks(blocks: usize) -> usize {
-    (0..blocks).find(|&k| binomial_tail(blocks, ALPHA, k + 1) < 0.01).expect("the tail vanishes")
+    (0..blocks)
+        .find(|&k| binomial_tail(blocks, ALPHA, k + 1) < 0.01)
+        .expect("the tail vanishes")
 }
 
 #[test]

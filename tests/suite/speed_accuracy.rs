@@ -55,7 +55,10 @@ fn stability_small_run_is_finite_and_keeps_energy_within_2_percent() {
             let run: Vec<_> = rows.iter().filter(|r| r.method == method && r.motion == motion).collect();
             let energy = run.iter().map(|r| r.energy_ratio).sum::<f64>() / run.len() as f64;
             assert!((energy - 1.0).abs() < 0.02, "{method} {motion:?}: energy {energy}");
-            assert_eq!(run.iter().filter(|r| r.flicker.is_some()).count(), if motion == CameraMotion::Static { 15 } else { 0 });
+            assert_eq!(
+                run.iter().filter(|r| r.flicker.is_some()).count(),
+                if motion == CameraMotion::Static { 15 } else { 0 }
+            );
             assert!(run.iter().all(|r| r.rel_mse.is_finite() && r.rel_mse > 0.0));
             if method != "pt" {
                 assert!(run.iter().all(|r| r.failed_shift_rate.is_some_and(|f| f > 0.0 && f < 0.2)));
