@@ -1,4 +1,5 @@
-//! Image error metrics against a reference: relMSE, MSE, energy and frame-to-frame flicker.
+//! Image error metrics against a reference: relMSE (also trimmed), MSE, energy and
+//! frame-to-frame flicker.
 
 use glam::Vec3;
 
@@ -24,6 +25,20 @@ pub fn rel_mse(image: &[Vec3], reference: &[Vec3]) -> f64 {
     check_sizes(image, reference);
     let sum: f64 = image.iter().zip(reference).map(|(x, r)| rel_squared_error(*x, *r)).sum();
     sum / (3 * image.len().max(1)) as f64
+}
+
+/// The share of pixels `rel_mse_trimmed` leaves out: 0.1%, as papers on path guiding do, so
+/// that a handful of fireflies does not decide a single frame's error.
+pub const TRIMMED_SHARE: f64 = 1e-3;
+
+/// relMSE without the largest `share` of per-pixel errors (floor(share × pixels) pixels),
+/// averaged over the pixels kept.
+pub fn rel_mse_trimmed(image: &[Vec3], reference: &[Vec3], share: f64) -> f64 {
+    check_sizes(image, reference);
+    let mut errors: Vec<f64> = image.iter().zip(reference).map(|(x, r)| rel_squared_error(*x, *r)).collect();
+    errors.sort_by(f64::total_cmp);
+    let kept = errors.len() - (share * errors.len() as f64).floor() as usize;
+    errors[..kept].iter().sum::<f64>() / (3 * kept.max(1)) as f64
 }
 
 /// Mean over pixels and channels of (x - r)^2.

@@ -12,7 +12,7 @@ use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
 use crate::image_io::read_exr;
-use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_squared_error};
+use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, rel_squared_error, TRIMMED_SHARE};
 use crate::render::{Image, RenderSettings, RestirSettings, MAX_CANDIDATES};
 use crate::scene::Scene;
 
@@ -42,6 +42,8 @@ pub struct CompareRow {
     pub knob: String,
     pub gpu_ms_per_frame: f64,
     pub rel_mse: f64,
+    /// relMSE without the largest 0.1% of pixel errors (metrics::rel_mse_trimmed).
+    pub rel_mse_trimmed: f64,
     pub mse: f64,
     pub energy_ratio: f64,
     pub failed_shift_rate: Option<f64>,
@@ -163,16 +165,19 @@ fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> 
 }
 
 fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
-    let mut csv = String::from("method,budget_ms,knob,gpu_ms_per_frame,rel_mse,mse,energy_ratio,failed_shift_rate,nonfinite_pixels\n");
+    let mut csv = String::from(
+        "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels\n",
+    );
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.5},{},{}",
+            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.6e},{:.5},{},{}",
             r.method,
             r.budget_ms,
             r.knob,
             r.gpu_ms_per_frame,
             r.rel_mse,
+            r.rel_mse_trimmed,
             r.mse,
             r.energy_ratio,
             r.failed_shift_rate.map(|f| format!("{f:.5}")).unwrap_or_default(),
@@ -256,12 +261,13 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
                 continue;
             };
             renderer.set_cost_knob(knob)?;
-            let (mut times, mut rel, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, None, 0);
+            let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
             let mut last = None;
             for t in 0..args.trials {
                 let seq = run.sequence(renderer, args.frames, args.seed.wrapping_add(1 + t))?;
                 times.push(seq.gpu_ms_per_frame);
                 rel += rel_mse(&seq.last_frame.mean, &reference) / args.trials as f64;
+                trimmed += rel_mse_trimmed(&seq.last_frame.mean, &reference, TRIMMED_SHARE) / args.trials as f64;
                 abs += mse(&seq.last_frame.mean, &reference) / args.trials as f64;
                 energy += energy_ratio(&seq.last_frame.mean, &reference) / args.trials as f64;
                 failed = seq.failed_shift_rate.map(|f| failed.unwrap_or(0.0) + f / args.trials as f64);
@@ -274,18 +280,20 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
                 knob: format!("{}={knob}", renderer.cost_knob_name()),
                 gpu_ms_per_frame: median(&times),
                 rel_mse: rel,
+                rel_mse_trimmed: trimmed,
                 mse: abs,
                 energy_ratio: energy,
                 failed_shift_rate: failed,
                 nonfinite_pixels: nonfinite,
             };
             println!(
-                "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e} | MSE {:.4e} | energy {:.4}{}",
+                "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e} (trimmed {:.4e}) | MSE {:.4e} | energy {:.4}{}",
                 row.method,
                 budget,
                 row.knob,
                 row.gpu_ms_per_frame,
                 row.rel_mse,
+                row.rel_mse_trimmed,
                 row.mse,
                 row.energy_ratio,
                 row.failed_shift_rate
@@ -352,7 +360,7 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
 }
 
 /// For each budget where the path tracer and ReSTIR PT both ran: the path tracer's relMSE over
-/// the best ReSTIR PT method's.
+/// the best ReSTIR PT method's, plain and trimmed.
 fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
     for &budget in budgets {
         let at = |pred: &dyn Fn(&CompareRow) -> bool| {
@@ -369,6 +377,19 @@ fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
                 best.rel_mse,
                 best.gpu_ms_per_frame,
                 pt.rel_mse / best.rel_mse
+            );
+        }
+        let trimmed_best = rows
+            .iter()
+            .filter(|r| r.budget_ms == budget && r.method != "pt")
+            .min_by(|a, b| a.rel_mse_trimmed.total_cmp(&b.rel_mse_trimmed));
+        if let (Some(pt), Some(best)) = (rows.iter().find(|r| r.budget_ms == budget && r.method == "pt"), trimmed_best) {
+            println!(
+                "equal time {budget:.1} ms, trimmed relMSE: pt {:.4e} / {} {:.4e} = {:.2}x",
+                pt.rel_mse_trimmed,
+                best.method,
+                best.rel_mse_trimmed,
+                pt.rel_mse_trimmed / best.rel_mse_trimmed
             );
         }
     }

@@ -320,14 +320,17 @@ fn cli_compare_writes_results_charts_and_strip() {
     for row in &rows {
         let rel_mse: f64 = row[4].parse().unwrap();
         let gpu_ms: f64 = row[3].parse().unwrap();
+        let trimmed: f64 = row[5].parse().unwrap();
         assert!(rel_mse.is_finite() && rel_mse > 0.0 && gpu_ms > 0.0, "{row:?}");
-        assert_eq!(row[8], "0", "non-finite pixels: {row:?}");
+        assert!(trimmed > 0.0 && trimmed <= rel_mse, "trimmed relMSE: {row:?}");
+        assert_eq!(row[9], "0", "non-finite pixels: {row:?}");
     }
     // A larger budget buys the path tracer more samples per frame.
     let spp = |r: &Vec<&str>| r[2].trim_start_matches("spp=").parse::<u32>().unwrap();
     assert!(rows[0][0] == "pt" && rows[1][0] == "pt" && spp(&rows[1]) > spp(&rows[0]), "{csv}");
     assert!(rows[2][2].starts_with("candidates="), "{csv}");
     assert!(stdout.contains("equal time 1000.0 ms: pt relMSE"), "{stdout}");
+    assert!(stdout.contains("equal time 1000.0 ms, trimmed relMSE: pt"), "{stdout}");
     for chart in ["rel_mse_vs_time", "mse_vs_time"] {
         assert!(std::fs::read_to_string(dir.join(format!("{chart}.svg"))).unwrap().contains("<svg"));
         assert!(std::fs::read(dir.join(format!("{chart}.png"))).unwrap().starts_with(b"\x89PNG"));

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use restir_pt::cli::{stability, CameraMotion, DeviceArgs, StabilityArgs};
-use restir_pt::metrics::{energy_ratio, flicker, rel_mse};
+use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
 use restir_pt::render::RestirSettings;
 
 use crate::common::{repo_path, temp_file};
@@ -19,6 +19,14 @@ fn metrics_rel_mse_energy_and_flicker_match_hand_values() {
     assert!((energy_ratio(&image, &reference) - 2.1).abs() < 1e-5);
     // Luminance changes of 1 and 0.1 against a mean reference luminance of 0.5.
     assert!((flicker(&reference, &image, &reference) - 1.1).abs() < 1e-5);
+    // 1000 pixels: one firefly (error 100 per channel against a reference of 0) and 999 with
+    // error 0.01 per channel. Trimming 0.1% drops exactly the firefly.
+    let mut noisy = vec![Vec3::splat(0.01); 999];
+    noisy.push(Vec3::splat(1.0));
+    let black = vec![Vec3::ZERO; 1000];
+    assert!((rel_mse(&noisy, &black) - (999.0 * 0.01 + 100.0) / 1000.0).abs() < 1e-6);
+    assert!((rel_mse_trimmed(&noisy, &black, 1e-3) - 0.01).abs() < 1e-6);
+    assert!((rel_mse_trimmed(&noisy, &black, 0.0) - rel_mse(&noisy, &black)).abs() < 1e-9);
 }
 
 /// The path tracer and ReSTIR PT (hybrid) on cornell, 64x64, 16 frames with a static and a
