@@ -341,9 +341,10 @@ fn restir_unbiased_cornell_glossy() {
 // initial path per pixel (measured over 384 renders: energy 1.0018, standard error 0.0064),
 // and by 14.5% for the path tracer at 1 spp; resolving 1% would take over a thousand renders
 // per configuration. Eight initial paths bring it to 7.7%, so 256 renders measure energy to
-// about 0.5%. About 20 minutes.
+// about 0.6%. Over an hour on 2 cores (reconnection about 6 minutes per configuration, replay
+// over 15).
 #[test]
-#[ignore = "20 minutes; run with --ignored (docs/restir.md)"]
+#[ignore = "over an hour; run with --ignored (docs/restir.md)"]
 fn restir_unbiased_veach_door() {
     check_unbiased(Unbiasedness {
         scene: "veach-door",
