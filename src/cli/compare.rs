@@ -362,13 +362,15 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
 /// For each budget where the path tracer and ReSTIR PT both ran: the path tracer's relMSE over
 /// the best ReSTIR PT method's, plain and trimmed.
 fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
+    type Error = fn(&CompareRow) -> f64;
     for &budget in budgets {
-        let at = |pred: &dyn Fn(&CompareRow) -> bool| {
+        let lowest = |pt: bool, error: Error| {
             rows.iter()
-                .filter(|r| r.budget_ms == budget && pred(r))
-                .min_by(|a, b| a.rel_mse.total_cmp(&b.rel_mse))
+                .filter(|r| r.budget_ms == budget && (r.method == "pt") == pt)
+                .min_by(|a, b| error(a).total_cmp(&error(b)))
         };
-        if let (Some(pt), Some(best)) = (at(&|r| r.method == "pt"), at(&|r| r.method != "pt")) {
+        let plain: Error = |r| r.rel_mse;
+        if let (Some(pt), Some(best)) = (lowest(true, plain), lowest(false, plain)) {
             println!(
                 "equal time {budget:.1} ms: pt relMSE {:.4e} ({:.1} ms) / {} relMSE {:.4e} ({:.1} ms) = {:.2}x",
                 pt.rel_mse,
@@ -379,11 +381,8 @@ fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
                 pt.rel_mse / best.rel_mse
             );
         }
-        let trimmed_best = rows
-            .iter()
-            .filter(|r| r.budget_ms == budget && r.method != "pt")
-            .min_by(|a, b| a.rel_mse_trimmed.total_cmp(&b.rel_mse_trimmed));
-        if let (Some(pt), Some(best)) = (rows.iter().find(|r| r.budget_ms == budget && r.method == "pt"), trimmed_best) {
+        let trimmed: Error = |r| r.rel_mse_trimmed;
+        if let (Some(pt), Some(best)) = (lowest(true, trimmed), lowest(false, trimmed)) {
             println!(
                 "equal time {budget:.1} ms, trimmed relMSE: pt {:.4e} / {} {:.4e} = {:.2}x",
                 pt.rel_mse_trimmed,
