@@ -304,9 +304,6 @@ impl Restir {
 
     /// The average of the frames accumulated since the last restart.
     pub fn image(&self) -> Result<Image> {
-        let n = self.settings.pixel_count();
-        let sums: Vec<[f32; 4]> = self.accum.read(n)?;
-        let sums_sq: Vec<[f32; 4]> = self.accum_sq.read(n)?;
-        Ok(Image::from_sums(self.settings.width, self.settings.height, &sums, &sums_sq))
+        Ok(Image::read_accumulation(&self.settings, &self.accum, &self.accum_sq)?)
     }
 }
