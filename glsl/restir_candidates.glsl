@@ -33,13 +33,7 @@ void offer_candidate(inout Resampler s, Path q, ShiftParams params, float scale,
 void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed, uint max_length, ShiftParams params,
                             float scale) {
     Path p;
-    p.seed = seed;
-    p.camera = camera;
-    p.count = 1u;
-    p.nee_end = false;
-    p.vertices[0] = y1;
-    p.contribution = vec3(0.0);
-    p.end_weight = 0.0;
+    path_begin(camera, y1, seed, false, p);
     vec3 prefix = vec3(1.0);
     vec3 prev_pos = camera;
     for (uint i = 1u; i < max_length; ++i) {

@@ -150,8 +150,8 @@ bool bsdf_vertex(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSampl
     return true;
 }
 
-// The vertices, lobes and weights of a path regenerated from x1 with `seed`.
-bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
+// A path of the single vertex x1 from `camera`, to be extended with `seed`'s random numbers.
+void path_begin(vec3 camera, Vertex x1, uint seed, bool nee_end, out Path path) {
     path.seed = seed;
     path.camera = camera;
     path.count = 1u;
@@ -159,6 +159,11 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
     path.vertices[0] = x1;
     path.contribution = vec3(0.0);
     path.end_weight = 0.0;
+}
+
+// The vertices, lobes and weights of a path regenerated from x1 with `seed`.
+bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
+    path_begin(camera, x1, seed, nee_end, path);
     vec3 prev_pos = camera;
     while (path.count < target_length) {
         loop_tick();
