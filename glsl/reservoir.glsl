@@ -73,24 +73,31 @@ struct Resampler {
     float weight_sum;
     float confidence;
     vec3 expected;
+    bool chosen_lost;   // the chosen candidate could not be recorded: the result is empty
 };
 
 Resampler resampler_begin() {
-    return Resampler(reservoir_empty().record, 0.0, 0.0, 0.0, vec3(0.0));
+    return Resampler(reservoir_empty().record, 0.0, 0.0, 0.0, vec3(0.0), false);
 }
 
-// `u` uniform in [0, 1); `w` finite and positive.
-void resampler_add(inout Resampler s, PathRecord y, float target, float w, float u) {
+// Adds a candidate of contribution f and target p̂ = `target` with weight `w` (finite, positive);
+// true if it becomes the chosen one, which the caller then stores in `chosen`. `u` is uniform
+// in [0, 1).
+bool resampler_offer(inout Resampler s, vec3 contribution, float target, float w, float u) {
     s.weight_sum += w;
-    s.expected += (w / target) * y.contribution;
-    if (u * s.weight_sum < w) {
-        s.chosen = y;
-        s.chosen_target = target;
-    }
+    s.expected += (w / target) * contribution;
+    if (u * s.weight_sum >= w) return false;
+    s.chosen_target = target;
+    s.chosen_lost = false;
+    return true;
+}
+
+void resampler_add(inout Resampler s, PathRecord y, float target, float w, float u) {
+    if (resampler_offer(s, y.contribution, target, w, u)) s.chosen = y;
 }
 
 Reservoir resampler_finish(Resampler s) {
-    float W = s.weight_sum > 0.0 ? s.weight_sum / s.chosen_target : 0.0;
+    float W = s.weight_sum > 0.0 && !s.chosen_lost ? s.weight_sum / s.chosen_target : 0.0;
     return Reservoir(s.chosen, W, s.confidence);
 }
 

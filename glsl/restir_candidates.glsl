@@ -11,21 +11,52 @@
 #include "restir_bindings.glsl"
 #include "shift.glsl"
 
-// Offers the path `q` with weight p̂(q) * `scale` (the candidate's unbiased contribution weight
-// in primary sample space is 1; `scale` is the MIS weight 1/N among N traced paths).
-void offer_candidate(inout Resampler s, Path q, ShiftParams params, float scale, float u) {
-    PathRecord record;
-    if (!record_path(q, params, record)) {
-        local_candidates_dropped += 1u;
-        return;
-    }
-    float target = target_function(record.contribution);
+// A candidate of the path being traced, described against that path: its first `count`
+// vertices, the last replaced by a NEE light vertex when `nee_end`. The path only grows, so
+// the description stays valid until the path ends.
+struct TracedCandidate {
+    uint count;
+    bool nee_end;
+    Vertex light;
+    vec3 nee_weight;
+    float end_weight;
+    vec3 contribution;
+};
+
+// Offers a candidate of contribution f with weight p̂(f) * `scale` (its unbiased contribution
+// weight in primary sample space is 1; `scale` is the MIS weight 1/N among N traced paths);
+// true if the resampler chose it.
+bool offer_candidate(inout Resampler s, vec3 contribution, float scale, float u) {
+    float target = target_function(contribution);
     float w = target * scale;
     if (!is_finite(w)) {
         local_nonfinite_weights += 1u;
-        return;
+        return false;
     }
-    if (w > 0.0) resampler_add(s, record, target, w, u);
+    return w > 0.0 && resampler_offer(s, contribution, target, w, u);
+}
+
+// Records the chosen candidate `c` of the finished path `p` as the resampler's sample. Recording
+// (record_path) costs more than tracing the path, so it is done once per path rather than per
+// candidate. It recomputes the contribution from the vertices and cannot fail where the traced
+// contribution was positive, except by rounding; such a loss is counted and empties the result.
+void record_chosen(inout Resampler s, Path p, TracedCandidate c, ShiftParams params) {
+    p.count = c.count;
+    p.nee_end = c.nee_end;
+    if (c.nee_end) {
+        p.vertices[c.count - 1u] = c.light;
+        p.lobes[c.count - 2u] = LOBE_NONE;
+        p.weights[c.count - 2u] = c.nee_weight;
+    }
+    p.end_weight = c.end_weight;
+    p.contribution = c.contribution;
+    PathRecord record;
+    if (record_path(p, params, record)) {
+        s.chosen = record;
+    } else {
+        local_candidates_dropped += 1u;
+        s.chosen_lost = true;
+    }
 }
 
 // Streams every light-ending prefix of at most `max_length` vertices of the path from y1 with
@@ -36,6 +67,8 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
     path_begin(camera, y1, seed, false, p);
     vec3 prefix = vec3(1.0);
     vec3 prev_pos = camera;
+    TracedCandidate chosen;
+    bool chose = false;
     for (uint i = 1u; i < max_length; ++i) {
         loop_tick();
         Vertex x = p.vertices[i - 1u];
@@ -50,15 +83,13 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
             float bsdf_pdf;
             vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
             if (max_component(f_cos) > 0.0 && visible(x, light)) {
-                Path q = p;
-                q.count = i + 1u;
-                q.nee_end = true;
-                q.vertices[i] = light;
-                q.lobes[i - 1u] = LOBE_NONE;
-                q.weights[i - 1u] = f_cos / ls.pdf;
-                q.end_weight = end_mis_weight(x, prev_pos, light, true, false);
-                q.contribution = prefix * q.weights[i - 1u] * end_emission(x, light) * q.end_weight;
-                if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.x);
+                vec3 weight = f_cos / ls.pdf;
+                float end_weight = end_mis_weight(x, prev_pos, light, true, false);
+                vec3 contribution = prefix * weight * end_emission(x, light) * end_weight;
+                if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u.x)) {
+                    chosen = TracedCandidate(i + 1u, true, light, weight, end_weight, contribution);
+                    chose = true;
+                }
             }
         }
 
@@ -72,13 +103,16 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         prefix *= b.weight;
         vec3 emitted = end_emission(x, next);
         if (max_component(emitted) > 0.0) {
-            Path q = p;
-            q.end_weight = end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
-            q.contribution = prefix * emitted * q.end_weight;
-            if (max_component(q.contribution) > 0.0) offer_candidate(s, q, params, scale, u.y);
+            float end_weight = end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
+            vec3 contribution = prefix * emitted * end_weight;
+            if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u.y)) {
+                chosen = TracedCandidate(i + 1u, false, next, vec3(0.0), end_weight, contribution);
+                chose = true;
+            }
         }
         prev_pos = x.pos;
     }
+    if (chose) record_chosen(s, p, chosen, params);
 }
 
 #endif
