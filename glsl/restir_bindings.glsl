@@ -25,7 +25,7 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
     uint candidates;         // initial paths per pixel
     uint neighbours;         // spatial neighbours per round
     uint temporal_valid;     // 1 if the previous frame's reservoirs and surfaces exist
-    uint pad0;
+    uint emission_rays;      // camera rays per pixel for the emission seen at the primary hit
     uint pad1;
 };
 

@@ -8,6 +8,27 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "restir_candidates.glsl"
 #include "camera.glsl"
 
+// The radiance a camera ray in `dir` receives directly from what it hits (or escapes to).
+vec3 seen_emission(Hit hit, vec3 dir) {
+    if (hit.triangle == NO_HIT) return SCENE_ENVIRONMENT != 0 ? scene_env.rgb : vec3(0.0);
+    Triangle tri = triangles[hit.triangle];
+    return SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER ? emitted_radiance(tri, -dir) : vec3(0.0);
+}
+
+// The pixel's mean directly seen emission over `emission_rays` jittered camera rays, the first
+// being the reservoir's (`first_hit`). It is estimated apart from the reservoir's paths, which
+// start at the primary hit, so more rays cut the noise of a light's edge without bias.
+vec3 pixel_emission(uvec2 p, uint seed, vec3 camera, vec3 first_dir, Hit first_hit) {
+    vec3 sum = seen_emission(first_hit, first_dir);
+    for (uint j = 1u; j < emission_rays; ++j) {
+        loop_tick();
+        vec4 jitter = rng_uniform4(seed, j, STREAM_CAMERA);
+        vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
+        sum += seen_emission(trace_closest(camera, dir, SHIFT_RAY_TMAX), dir);
+    }
+    return sum / float(emission_rays);
+}
+
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
@@ -20,15 +41,10 @@ void main() {
         vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
         Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
         Surface surface = Surface(vec3(0.0), NO_HIT, camera, 0.0);
-        vec3 emitted = vec3(0.0);
         Resampler s = resampler_begin();
-        if (hit.triangle == NO_HIT) {
-            if (SCENE_ENVIRONMENT != 0) emitted = scene_env.rgb;
-        } else {
+        if (hit.triangle != NO_HIT) {
             Vertex y1 = hit_vertex(hit);
             surface = Surface(y1.pos, hit.triangle, camera, hit.t);
-            Triangle tri = triangles[hit.triangle];
-            if (SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER) emitted = emitted_radiance(tri, -dir);
             ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
             uint max_length = min(max_depth, MAX_PATH_LENGTH);
             float scale = 1.0 / float(candidates);
@@ -39,7 +55,7 @@ void main() {
             s.confidence = float(candidates);
         }
         store_surface(surface_slot, pixel, surface);
-        direct[pixel] = vec4(emitted, 0.0);
+        direct[pixel] = vec4(pixel_emission(p, seed0, camera, dir, hit), 0.0);
         expectation[pixel] = vec4(s.expected, 0.0);
         store_reservoir(out_slot, pixel, resampler_finish(s));
     }

@@ -118,7 +118,7 @@ pub struct ReuseParams {
     pub candidates: u32,
     pub neighbours: u32,
     pub temporal_valid: u32,
-    pub pad0: u32,
+    pub emission_rays: u32,
     pub pad1: u32,
 }
 

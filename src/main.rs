@@ -100,6 +100,10 @@ struct RestirOpts {
     /// ReSTIR PT: initial paths traced per pixel and frame.
     #[arg(long, default_value_t = 1)]
     candidates: u32,
+    /// ReSTIR PT: camera rays per pixel and frame that estimate the emission seen directly
+    /// (1: only the reservoir's primary ray); each further ray costs one closest-hit trace.
+    #[arg(long, default_value_t = RestirSettings::default().emission_rays)]
+    emission_rays: u32,
 }
 
 impl RestirOpts {
@@ -120,6 +124,7 @@ impl RestirOpts {
             rounds: self.rounds,
             m_cap: self.m_cap,
             candidates: self.candidates,
+            emission_rays: self.emission_rays,
             ..Default::default()
         }
     }

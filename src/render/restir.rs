@@ -217,6 +217,7 @@ impl Restir {
             candidates: self.restir.candidates,
             neighbours: self.restir.spatial,
             temporal_valid: (self.restir.temporal && self.history.is_some()) as u32,
+            emission_rays: self.restir.emission_rays,
             ..Default::default()
         };
         self.reuse.write(std::slice::from_ref(&reuse))?;

@@ -61,6 +61,7 @@ impl ReuseMis {
 pub const MAX_NEIGHBOURS: u32 = 8;
 pub const MAX_ROUNDS: u32 = 3;
 pub const MAX_CANDIDATES: u32 = 64;
+pub const MAX_EMISSION_RAYS: u32 = 64;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct RestirSettings {
@@ -75,6 +76,11 @@ pub struct RestirSettings {
     pub m_cap: f32,
     /// Initial paths per pixel.
     pub candidates: u32,
+    /// Camera rays per pixel that estimate the emission seen at the primary hit, the
+    /// reservoir's own primary ray included. The emission term is estimated apart from the
+    /// reservoir's paths, so extra rays cut its anti-aliasing noise (a light's edge seen by one
+    /// jittered ray) without bias, at the cost of one closest-hit trace each.
+    pub emission_rays: u32,
     pub normal_threshold: f32,
     pub depth_threshold: f32,
 }
@@ -90,6 +96,7 @@ impl Default for RestirSettings {
             rounds: 1,
             m_cap: 20.0,
             candidates: 1,
+            emission_rays: 4,
             normal_threshold: 0.9,
             depth_threshold: 0.1,
         }
@@ -117,6 +124,12 @@ impl RestirSettings {
             bail!(
                 "--candidates {} is out of range: 1 to {MAX_CANDIDATES} paths per pixel",
                 self.candidates
+            );
+        }
+        if !(1..=MAX_EMISSION_RAYS).contains(&self.emission_rays) {
+            bail!(
+                "--emission-rays {} is out of range: 1 to {MAX_EMISSION_RAYS} camera rays per pixel",
+                self.emission_rays
             );
         }
         Ok(())

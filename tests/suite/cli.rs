@@ -245,6 +245,7 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
     assert_clean_failure(&["render", "--spatial", "9"], &["--spatial 9"]);
     assert_clean_failure(&["render", "--rounds", "4"], &["--rounds 4"]);
     assert_clean_failure(&["render", "--m-cap", "NaN"], &["--m-cap"]);
+    assert_clean_failure(&["render", "--emission-rays", "0"], &["--emission-rays 0", "1 to 64"]);
 }
 
 /// `restir-pt reference` of cornell at 16x16 into `dir/ref.exr`.
