@@ -325,9 +325,9 @@ fn restir_unbiased_cornell() {
 // The glossy spheres (roughness 0.05 and 0.1) reflect the small light through rare, large
 // samples. With 32 renders the unbiased path tracer itself fails 6 to 10 of 64 blocks (1 to 4
 // spp, all too dark), 5 with 128 and 2 with 512; hence 128 renders and the path-tracer
-// control. About 15 minutes.
+// control. This and restir_unbiased_veach_door took 867 s together on 2 cores.
 #[test]
-#[ignore = "15 minutes; run with --ignored (docs/restir.md)"]
+#[ignore = "minutes; run with --ignored (docs/restir.md)"]
 fn restir_unbiased_cornell_glossy() {
     check_unbiased(Unbiasedness {
         scene: "cornell-glossy",
@@ -341,10 +341,9 @@ fn restir_unbiased_cornell_glossy() {
 // initial path per pixel (measured over 384 renders: energy 1.0018, standard error 0.0064),
 // and by 14.5% for the path tracer at 1 spp; resolving 1% would take over a thousand renders
 // per configuration. Eight initial paths bring it to 7.7%, so 256 renders measure energy to
-// about 0.6%. Over an hour on 2 cores (reconnection about 6 minutes per configuration, replay
-// over 15).
+// about 0.6%.
 #[test]
-#[ignore = "over an hour; run with --ignored (docs/restir.md)"]
+#[ignore = "minutes; run with --ignored (docs/restir.md)"]
 fn restir_unbiased_veach_door() {
     check_unbiased(Unbiasedness {
         scene: "veach-door",
