@@ -37,9 +37,10 @@ bool offer_candidate(inout Resampler s, vec3 contribution, float scale, float u)
 }
 
 // Records the chosen candidate `c` of the finished path `p` as the resampler's sample. Recording
-// (record_path) costs more than tracing the path, so it is done once per path rather than per
-// candidate. It recomputes the contribution from the vertices and cannot fail where the traced
-// contribution was positive, except by rounding; such a loss is counted and empties the result.
+// every candidate (record_path) took longer than tracing the path, so only the path's last
+// choice is recorded. It recomputes the contribution from the vertices and cannot fail where the
+// traced contribution was positive, except by rounding; such a loss is counted and empties the
+// result.
 void record_chosen(inout Resampler s, Path p, TracedCandidate c, ShiftParams params) {
     p.count = c.count;
     p.nee_end = c.nee_end;
