@@ -124,15 +124,19 @@ impl Run<'_> {
                 Ok(Cost::PerSample(ms / SAMPLES as f64))
             }
             MethodRenderer::Restir(_) => {
+                // The slope comes from 1 and 4 candidates. From 1 and 2 it once read under 5% of
+                // a frame where a candidate cost about 9 ms (veach-door, 8 pairwise
+                // neighbours), and a 127 ms budget was spent as 23 candidates at 255 ms.
                 const FRAMES: u32 = 4;
+                const MORE: u32 = 4;
                 renderer.set_cost_knob(1)?;
                 self.sequence(renderer, FRAMES, 0)?;
                 let base = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
-                renderer.set_cost_knob(2)?;
-                let two = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
+                renderer.set_cost_knob(MORE)?;
+                let more = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
                 Ok(Cost::Frame {
                     base,
-                    per_candidate: (two - base).max(0.05 * base),
+                    per_candidate: ((more - base) / (MORE - 1) as f64).max(0.05 * base),
                 })
             }
         }
@@ -306,7 +310,9 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     }
     drop(renderers);
     finish_device(&ctx)?;
-    report_equal_time(&rows, &budgets);
+    for line in equal_time_lines(&rows, &budgets) {
+        println!("{line}");
+    }
 
     write_csv(&args.out_dir.join("results.csv"), &rows)?;
     let title = format!(
@@ -359,19 +365,34 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     Ok(rows)
 }
 
-/// For each budget where the path tracer and ReSTIR PT both ran: the path tracer's relMSE over
-/// the best ReSTIR PT method's, plain and trimmed.
-fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
+/// A run whose frames took longer than this multiple of its budget is not an equal-time point:
+/// the cost model fits budgets from a few calibration frames, and a method whose cost grows
+/// faster than linearly with its knob can overshoot.
+const OVER_BUDGET_TOLERANCE: f64 = 1.2;
+
+/// For each budget where the path tracer and ReSTIR PT both ran within it: the path tracer's
+/// relMSE over the best ReSTIR PT method's, plain and trimmed, and a line for each run left out
+/// for overshooting its budget.
+pub fn equal_time_lines(rows: &[CompareRow], budgets: &[f64]) -> Vec<String> {
     type Error = fn(&CompareRow) -> f64;
+    let mut lines = vec![];
     for &budget in budgets {
+        let within = |r: &&CompareRow| r.gpu_ms_per_frame <= OVER_BUDGET_TOLERANCE * budget;
+        for r in rows.iter().filter(|r| r.budget_ms == budget && !within(r)) {
+            lines.push(format!(
+                "equal time {budget:.1} ms: {} left out, its frames took {:.1} ms",
+                r.method, r.gpu_ms_per_frame
+            ));
+        }
         let lowest = |pt: bool, error: Error| {
             rows.iter()
                 .filter(|r| r.budget_ms == budget && (r.method == "pt") == pt)
+                .filter(within)
                 .min_by(|a, b| error(a).total_cmp(&error(b)))
         };
         let plain: Error = |r| r.rel_mse;
         if let (Some(pt), Some(best)) = (lowest(true, plain), lowest(false, plain)) {
-            println!(
+            lines.push(format!(
                 "equal time {budget:.1} ms: pt relMSE {:.4e} ({:.1} ms) / {} relMSE {:.4e} ({:.1} ms) = {:.2}x",
                 pt.rel_mse,
                 pt.gpu_ms_per_frame,
@@ -379,19 +400,20 @@ fn report_equal_time(rows: &[CompareRow], budgets: &[f64]) {
                 best.rel_mse,
                 best.gpu_ms_per_frame,
                 pt.rel_mse / best.rel_mse
-            );
+            ));
         }
         let trimmed: Error = |r| r.rel_mse_trimmed;
         if let (Some(pt), Some(best)) = (lowest(true, trimmed), lowest(false, trimmed)) {
-            println!(
+            lines.push(format!(
                 "equal time {budget:.1} ms, trimmed relMSE: pt {:.4e} / {} {:.4e} = {:.2}x",
                 pt.rel_mse_trimmed,
                 best.method,
                 best.rel_mse_trimmed,
                 pt.rel_mse_trimmed / best.rel_mse_trimmed
-            );
+            ));
         }
     }
+    lines
 }
 
 /// The strip of the largest budget every method fit (or the largest budget run at all).

@@ -10,7 +10,7 @@ mod render;
 mod stability;
 
 pub use bench::{bench, BenchArgs};
-pub use compare::{compare, CompareArgs, CompareRow};
+pub use compare::{compare, equal_time_lines, CompareArgs, CompareRow};
 pub use info::info;
 pub use method_spec::MethodSpec;
 pub use profile::{profile, ProfileArgs};

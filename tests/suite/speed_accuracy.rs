@@ -2,7 +2,7 @@
 //! energy within 2% of the references) and `compare`'s files.
 
 use glam::Vec3;
-use restir_pt::cli::{stability, CameraMotion, DeviceArgs, StabilityArgs};
+use restir_pt::cli::{equal_time_lines, stability, CameraMotion, CompareRow, DeviceArgs, StabilityArgs};
 use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
 use restir_pt::render::RestirSettings;
 
@@ -27,6 +27,41 @@ fn metrics_rel_mse_energy_and_flicker_match_hand_values() {
     assert!((rel_mse(&noisy, &black) - (999.0 * 0.01 + 100.0) / 1000.0).abs() < 1e-6);
     assert!((rel_mse_trimmed(&noisy, &black, 1e-3) - 0.01).abs() < 1e-6);
     assert!((rel_mse_trimmed(&noisy, &black, 0.0) - rel_mse(&noisy, &black)).abs() < 1e-9);
+}
+
+fn compare_row(method: &str, gpu_ms_per_frame: f64, rel_mse: f64) -> CompareRow {
+    CompareRow {
+        method: method.to_string(),
+        budget_ms: 100.0,
+        knob: String::new(),
+        gpu_ms_per_frame,
+        rel_mse,
+        rel_mse_trimmed: rel_mse / 2.0,
+        mse: rel_mse,
+        energy_ratio: 1.0,
+        failed_shift_rate: None,
+        nonfinite_pixels: 0,
+    }
+}
+
+/// The equal-time ratio takes the best ReSTIR PT run within 20% of the budget; a run that
+/// overshot it (here 190 ms for 100) is named and left out, however low its error.
+#[test]
+fn compare_equal_time_leaves_out_runs_over_budget() {
+    let rows = [
+        compare_row("pt", 95.0, 0.4),
+        compare_row("restir:reconnection/gbh", 110.0, 0.2),
+        compare_row("restir:hybrid/gbh", 190.0, 0.01),
+    ];
+    let lines = equal_time_lines(&rows, &[100.0]);
+    assert_eq!(
+        lines,
+        [
+            "equal time 100.0 ms: restir:hybrid/gbh left out, its frames took 190.0 ms",
+            "equal time 100.0 ms: pt relMSE 4.0000e-1 (95.0 ms) / restir:reconnection/gbh relMSE 2.0000e-1 (110.0 ms) = 2.00x",
+            "equal time 100.0 ms, trimmed relMSE: pt 2.0000e-1 / restir:reconnection/gbh 1.0000e-1 = 2.00x",
+        ]
+    );
 }
 
 /// The path tracer and ReSTIR PT (hybrid) on cornell, 64x64, 16 frames with a static and a
