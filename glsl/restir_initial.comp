@@ -8,23 +8,23 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "restir_candidates.glsl"
 #include "camera.glsl"
 
-// The radiance a camera ray in `dir` receives directly from what it hits (or escapes to).
-vec3 seen_emission(Hit hit, vec3 dir) {
-    if (hit.triangle == NO_HIT) return SCENE_ENVIRONMENT != 0 ? scene_env.rgb : vec3(0.0);
-    Triangle tri = triangles[hit.triangle];
-    return SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER ? emitted_radiance(tri, -dir) : vec3(0.0);
+// The radiance a camera ray from `camera` in `dir` receives directly from what it hits (or
+// escapes to): end_emission of the one-segment path.
+vec3 seen_emission(vec3 camera, Hit hit, vec3 dir) {
+    Vertex end = hit.triangle == NO_HIT ? vertex_escaped(dir) : hit_vertex(hit);
+    return end_emission(Vertex(camera, vec3(0.0), NO_HIT), end);
 }
 
 // The pixel's mean directly seen emission over `emission_rays` jittered camera rays, the first
 // being the reservoir's (`first_hit`). It is estimated apart from the reservoir's paths, which
 // start at the primary hit, so more rays cut the noise of a light's edge without bias.
 vec3 pixel_emission(uvec2 p, uint seed, vec3 camera, vec3 first_dir, Hit first_hit) {
-    vec3 sum = seen_emission(first_hit, first_dir);
+    vec3 sum = seen_emission(camera, first_hit, first_dir);
     for (uint j = 1u; j < emission_rays; ++j) {
         loop_tick();
         vec4 jitter = rng_uniform4(seed, j, STREAM_CAMERA);
         vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
-        sum += seen_emission(trace_closest(camera, dir, SHIFT_RAY_TMAX), dir);
+        sum += seen_emission(camera, trace_closest(camera, dir, SHIFT_RAY_TMAX), dir);
     }
     return sum / float(emission_rays);
 }
