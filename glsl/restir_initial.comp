@@ -1,6 +1,7 @@
 #version 460
 // ReSTIR PT pass 1: the pixel's primary hit (its surface and the emission seen there) and the
-// initial reservoir from `candidates` traced paths (restir_candidates.glsl).
+// initial reservoir from `candidates` traced paths (restir_candidates.glsl), each through its own
+// sub-pixel position.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -35,27 +36,30 @@ void main() {
     uint pixel = p.y * width + p.x;
     if (inside) {
         uint first = frame_index * candidates;
-        uint seed0 = path_seed(pixel, first, render_seed);
-        vec4 jitter = rng_uniform4(seed0, 0u, STREAM_CAMERA);
         vec3 camera = cam_position.xyz;
-        vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
-        Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
         Surface surface = Surface(vec3(0.0), NO_HIT, camera, 0.0);
         Resampler s = resampler_begin();
-        if (hit.triangle != NO_HIT) {
-            Vertex y1 = hit_vertex(hit);
-            surface = Surface(y1.pos, hit.triangle, camera, hit.t);
-            ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
-            uint max_length = min(max_depth, MAX_PATH_LENGTH);
-            float scale = 1.0 / float(candidates);
-            for (uint c = 0u; c < candidates; ++c) {
-                loop_tick();
-                stream_path_candidates(s, camera, y1, path_seed(pixel, first + c, render_seed), max_length, params, scale);
+        ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
+        uint max_length = min(max_depth, MAX_PATH_LENGTH);
+        float scale = 1.0 / float(candidates);
+        vec3 emission = vec3(0.0);
+        // Each path has its own sub-pixel position, drawn from its seed (see Domain in
+        // restir_reuse.glsl); the first path's primary hit is the pixel's surface.
+        for (uint c = 0u; c < candidates; ++c) {
+            loop_tick();
+            uint seed = path_seed(pixel, first + c, render_seed);
+            vec4 jitter = rng_uniform4(seed, 0u, STREAM_CAMERA);
+            vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
+            Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
+            if (c == 0u) {
+                emission = pixel_emission(p, seed, camera, dir, hit);
+                if (hit.triangle != NO_HIT) surface = Surface(hit_vertex(hit).pos, hit.triangle, camera, hit.t);
             }
-            s.confidence = float(candidates);
+            if (hit.triangle != NO_HIT) stream_path_candidates(s, camera, hit_vertex(hit), seed, max_length, params, scale);
         }
+        s.confidence = float(candidates);
         store_surface(surface_slot, pixel, surface);
-        direct[pixel] = vec4(pixel_emission(p, seed0, camera, dir, hit), 0.0);
+        direct[pixel] = vec4(emission, 0.0);
         expectation[pixel] = vec4(s.expected, 0.0);
         store_reservoir(out_slot, pixel, resampler_finish(s));
     }

@@ -6,6 +6,7 @@
 #define RESTIR_REUSE_GLSL
 
 #include "restir_bindings.glsl"
+#include "camera.glsl"
 #include "shift.glsl"
 
 #define SHIFT_RECONNECTION 0
@@ -23,12 +24,21 @@
 // Canonical input plus up to 8 neighbours.
 const uint MAX_INPUTS = 9u;
 
-// One input of a resampling: a reservoir from the domain (camera, primary hit x1), and its
-// confidence weight c.
+// The domain of a reservoir: one pixel's paths seen from one frame's camera, the sub-pixel
+// position included. A path carries its own position (the camera stream of its seed), so a
+// shift keeps it and traces the target pixel's primary ray through it. Between two frames of a
+// static camera the domain of a pixel does not change and its paths are reused unshifted; with
+// the primary hit as the domain, the hit moved with every frame's jitter, and the reconnection
+// Jacobians of those moves multiplied along the temporal chain.
+struct Domain {
+    uvec2 pixel;
+    bool previous;   // seen from the previous frame's camera
+};
+
+// One input of a resampling: a reservoir of `domain`, and its confidence weight c.
 struct ReuseInput {
     Reservoir res;
-    vec3 camera;
-    Vertex x1;
+    Domain domain;
     float confidence;
 };
 
@@ -36,24 +46,56 @@ struct ReuseInput {
 // glslang's optimiser mistypes arrays of these structs passed by value.
 ReuseInput inputs[MAX_INPUTS];
 
-Vertex surface_vertex(Surface s) {
-    return vertex_on_surface(s.triangle, s.pos);
+CameraPose previous_camera() {
+    return CameraPose(prev_cam_position, prev_cam_right, prev_cam_up, prev_cam_forward);
+}
+
+CameraPose domain_camera(Domain d) {
+    return d.previous ? previous_camera() : frame_camera();
+}
+
+bool same_pose(CameraPose a, CameraPose b) {
+    return a.position == b.position && a.right == b.right && a.up == b.up && a.forward == b.forward;
+}
+
+bool same_domain(Domain a, Domain b) {
+    if (a.pixel != b.pixel) return false;
+    return a.previous == b.previous || same_pose(previous_camera(), frame_camera());
+}
+
+// The primary vertex of `record`'s path in domain `d`: the hit of d's camera ray through the
+// record's sub-pixel position; false if that ray escapes.
+bool domain_primary(Domain d, PathRecord record, out vec3 camera, out Vertex y1) {
+    CameraPose pose = domain_camera(d);
+    vec2 offset = rng_uniform4(record.seed, 0u, STREAM_CAMERA).xy;
+    camera = pose.position.xyz;
+    vec3 dir = pose_ray_dir(pose, float(d.pixel.x) + offset.x, float(d.pixel.y) + offset.y);
+    Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
+    if (hit.triangle == NO_HIT) return false;
+    y1 = hit_vertex(hit);
+    return true;
 }
 
 ShiftParams reuse_shift_params() {
     return ShiftParams(roughness_threshold, distance_threshold);
 }
 
-// The selected shift of `base` into the domain (camera, y1); every inverse is the same shift back.
-ShiftResult shift_path(PathRecord base, vec3 camera, Vertex y1) {
+// The selected shift of `base` from domain `from` into domain `to`, two different domains (within
+// one domain the shift is the identity, which callers skip); every inverse is the same shift back.
+ShiftResult shift_path(PathRecord base, Domain from, Domain to) {
     local_shifts_attempted += 1u;
+    vec3 camera;
+    Vertex y1;
+    ShiftResult s = shift_failed();
+    if (domain_primary(to, base, camera, y1)) {
 #if SHIFT_MODE == SHIFT_RECONNECTION
-    ShiftResult s = shift_reconnection(reuse_shift_params(), base, camera, y1);
+        s = shift_reconnection(reuse_shift_params(), base, camera, y1);
 #elif SHIFT_MODE == SHIFT_REPLAY
-    ShiftResult s = shift_random_replay(reuse_shift_params(), base, camera, y1);
+        s = shift_random_replay(reuse_shift_params(), base, camera, y1);
 #else
-    ShiftResult s = shift_hybrid(reuse_shift_params(), base, camera, y1);
+        s = shift_hybrid(reuse_shift_params(), base, camera, y1);
 #endif
+    }
     if (!s.valid) local_shifts_failed += 1u;
     return s;
 }
@@ -61,7 +103,8 @@ ShiftResult shift_path(PathRecord base, vec3 camera, Vertex y1) {
 // p̂_{<-l}(y) = p̂_l(T_l^{-1}(y)) |(T_l^{-1})'(y)| for y in the canonical domain; 0 where y
 // cannot be shifted into domain l. A non-finite value counts as a failed shift.
 float target_from(ReuseInput l, PathRecord y) {
-    ShiftResult s = shift_path(y, l.camera, l.x1);
+    if (same_domain(inputs[0].domain, l.domain)) return target_function(y.contribution);
+    ShiftResult s = shift_path(y, inputs[0].domain, l.domain);
     if (!s.valid) return 0.0;
     float t = target_function(s.contribution) * s.jacobian;
     if (!is_finite(t)) {
@@ -115,8 +158,9 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         if (!(inputs[i].res.W > 0.0)) continue;
         PathRecord y = inputs[i].res.record;
         float jacobian = 1.0;
-        if (i != 0u) {
-            ShiftResult shifted = shift_path(y, inputs[0].camera, inputs[0].x1);
+        bool shifted_in = !same_domain(inputs[i].domain, inputs[0].domain);
+        if (shifted_in) {
+            ShiftResult shifted = shift_path(y, inputs[i].domain, inputs[0].domain);
             if (!shifted.valid) continue;
             y = shifted.record;
             jacobian = shifted.jacobian;
@@ -125,7 +169,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         float w = mis_weight(n, i, y, p0, jacobian) * p0 * inputs[i].res.W * jacobian;
         if (!is_finite(w)) {
             local_nonfinite_weights += 1u;
-            if (i != 0u) local_shifts_failed += 1u;
+            if (shifted_in) local_shifts_failed += 1u;
             continue;
         }
         if (w > 0.0) resampler_add(s, y, p0, w, rng_uniform4(seed, i, STREAM_RESAMPLE).x);
@@ -139,8 +183,8 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
 // distance from the neighbour's camera.
 bool similar_surfaces(Surface canonical, Surface other) {
     if (canonical.triangle == NO_HIT || other.triangle == NO_HIT) return false;
-    vec3 n0 = surface_vertex(canonical).normal;
-    vec3 n1 = surface_vertex(other).normal;
+    vec3 n0 = vertex_on_surface(canonical.triangle, canonical.pos).normal;
+    vec3 n1 = vertex_on_surface(other.triangle, other.pos).normal;
     float expected = length(canonical.pos - other.camera);
     return abs(dot(n0, n1)) >= normal_threshold && abs(other.depth - expected) <= depth_threshold * other.depth;
 }

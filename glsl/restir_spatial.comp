@@ -18,7 +18,7 @@ void main() {
         Surface surface = load_surface(surface_slot, pixel);
         if (surface.triangle != NO_HIT) {
             uint seed = path_seed(pixel, frame_index, render_seed ^ pass_seed);
-            inputs[0] = ReuseInput(canonical, surface.camera, surface_vertex(surface), canonical.M);
+            inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
             uint n = 1u;
             for (uint j = 0u; j < min(neighbours, MAX_INPUTS - 1u); ++j) {
                 loop_tick();
@@ -31,7 +31,7 @@ void main() {
                 Surface other = load_surface(surface_slot, neighbour);
                 if (!similar_surfaces(surface, other)) continue;
                 Reservoir res = load_reservoir(in_slot, neighbour);
-                inputs[n] = ReuseInput(res, other.camera, surface_vertex(other), res.M);
+                inputs[n] = ReuseInput(res, Domain(uvec2(q), false), res.M);
                 n += 1u;
             }
             vec3 expected;

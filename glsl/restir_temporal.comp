@@ -33,10 +33,10 @@ void main() {
         if (temporal_valid != 0u && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
             Surface prev_surface = load_surface(1u - surface_slot, prev_pixel);
             if (similar_surfaces(surface, prev_surface)) {
-                inputs[0] = ReuseInput(canonical, surface.camera, surface_vertex(surface), canonical.M);
+                inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
                 Reservoir prev = load_reservoir(prev_slot, prev_pixel);
                 float confidence = min(prev.M, m_cap * canonical.M);
-                inputs[1] = ReuseInput(prev, prev_surface.camera, surface_vertex(prev_surface), confidence);
+                inputs[1] = ReuseInput(prev, Domain(uvec2(prev_pixel % width, prev_pixel / width), true), confidence);
                 vec3 expected;
                 result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed), expected);
                 expectation[pixel] = vec4(expected, 0.0);
