@@ -1,7 +1,8 @@
 #version 460
 // ReSTIR PT pass 2: temporal reuse. The pixel's primary hit is reprojected into the previous
-// frame's camera; that pixel's final reservoir is shifted into this pixel's domain and resampled
-// with this pixel's initial reservoir, its confidence capped at m_cap times the current M.
+// frame's camera (an unmoved camera keeps the pixel); that pixel's final reservoir is shifted
+// into this pixel's domain and resampled with this pixel's initial reservoir, its confidence
+// capped at m_cap times the current M.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -29,18 +30,23 @@ void main() {
         Reservoir canonical = load_reservoir(in_slot, pixel);
         Reservoir result = canonical;
         Surface surface = load_surface(surface_slot, pixel);
-        uint prev_pixel;
-        if (temporal_valid != 0u && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
-            Surface prev_surface = load_surface(1u - surface_slot, prev_pixel);
-            if (similar_surfaces(surface, prev_surface)) {
-                inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
-                Reservoir prev = load_reservoir(prev_slot, prev_pixel);
-                float confidence = min(prev.M, m_cap * canonical.M);
-                inputs[1] = ReuseInput(prev, Domain(uvec2(prev_pixel % width, prev_pixel / width), true), confidence);
-                vec3 expected;
-                result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed), expected);
-                expectation[pixel] = vec4(expected, 0.0);
-            }
+        // An unmoved camera sees the pixel's own domain again, whatever its jittered hits: the
+        // history is taken as it is (reprojecting this frame's hit could round into a neighbour
+        // at the pixel's edge, and an edge pixel's two hits may lie on different surfaces).
+        bool unmoved = same_pose(previous_camera(), frame_camera());
+        uint prev_pixel = pixel;
+        bool reusable = unmoved;
+        if (!unmoved && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
+            reusable = similar_surfaces(surface, load_surface(1u - surface_slot, prev_pixel));
+        }
+        if (temporal_valid != 0u && reusable) {
+            inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
+            Reservoir prev = load_reservoir(prev_slot, prev_pixel);
+            float confidence = min(prev.M, m_cap * canonical.M);
+            inputs[1] = ReuseInput(prev, Domain(uvec2(prev_pixel % width, prev_pixel / width), true), confidence);
+            vec3 expected;
+            result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed), expected);
+            expectation[pixel] = vec4(expected, 0.0);
         }
         store_reservoir(out_slot, pixel, result);
     }

@@ -426,6 +426,18 @@ fn restir_same_seed_is_bit_identical() {
     assert_clean(&ctx);
 }
 
+/// The Cornell box at 32x32 from camera 0, for tests of one pixel's frames.
+fn cornell_32_from_camera_0() -> (Scene, RenderSettings) {
+    let scene = load_scene(&repo_path("scenes/cornell.gltf")).unwrap();
+    let small = RenderSettings {
+        width: 32,
+        height: 32,
+        camera: 0,
+        ..settings(1)
+    };
+    (scene, small)
+}
+
 // The emission seen at the primary hit is estimated with its own camera rays. On the Cornell
 // box nearly all of a frame's pixel variance comes from the light's edge pixels, where one
 // jittered ray sees the light (radiance 17) or the ceiling; sixteen rays must cut the summed
@@ -434,13 +446,7 @@ fn restir_same_seed_is_bit_identical() {
 #[test]
 fn restir_emission_rays_cut_light_edge_variance() {
     let ctx = gpu();
-    let scene = load_scene(&repo_path("scenes/cornell.gltf")).unwrap();
-    let small = RenderSettings {
-        width: 32,
-        height: 32,
-        camera: 0,
-        ..settings(1)
-    };
+    let (scene, small) = cornell_32_from_camera_0();
     let total_variance = |emission_rays: u32| -> f64 {
         let restir = RestirSettings {
             emission_rays,
@@ -471,13 +477,7 @@ fn restir_emission_rays_cut_light_edge_variance() {
 #[test]
 fn restir_static_camera_temporal_reuse_shifts_nothing_and_accumulates() {
     let ctx = gpu();
-    let scene = load_scene(&repo_path("scenes/cornell.gltf")).unwrap();
-    let small = RenderSettings {
-        width: 32,
-        height: 32,
-        camera: 0,
-        ..settings(1)
-    };
+    let (scene, small) = cornell_32_from_camera_0();
     let mut pt = PathTracer::new(
         &ctx,
         &scene,
