@@ -51,11 +51,11 @@ void main() {
             vec4 jitter = rng_uniform4(seed, 0u, STREAM_CAMERA);
             vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
             Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
-            if (c == 0u) {
-                emission = pixel_emission(p, seed, camera, dir, hit);
-                if (hit.triangle != NO_HIT) surface = Surface(hit_vertex(hit).pos, hit.triangle, camera, hit.t);
-            }
-            if (hit.triangle != NO_HIT) stream_path_candidates(s, camera, hit_vertex(hit), seed, max_length, params, scale);
+            if (c == 0u) emission = pixel_emission(p, seed, camera, dir, hit);
+            if (hit.triangle == NO_HIT) continue;
+            Vertex y1 = hit_vertex(hit);
+            if (c == 0u) surface = Surface(y1.pos, hit.triangle, camera, hit.t);
+            stream_path_candidates(s, camera, y1, seed, max_length, params, scale);
         }
         s.confidence = float(candidates);
         store_surface(surface_slot, pixel, surface);

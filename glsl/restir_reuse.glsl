@@ -80,9 +80,9 @@ ShiftParams reuse_shift_params() {
     return ShiftParams(roughness_threshold, distance_threshold);
 }
 
-// The selected shift of `base` from domain `from` into domain `to`, two different domains (within
-// one domain the shift is the identity, which callers skip); every inverse is the same shift back.
-ShiftResult shift_path(PathRecord base, Domain from, Domain to) {
+// The selected shift of `base` into domain `to`, from another domain (within one domain the shift
+// is the identity, which callers skip); every inverse is the same shift back.
+ShiftResult shift_path(PathRecord base, Domain to) {
     local_shifts_attempted += 1u;
     vec3 camera;
     Vertex y1;
@@ -104,7 +104,7 @@ ShiftResult shift_path(PathRecord base, Domain from, Domain to) {
 // cannot be shifted into domain l. A non-finite value counts as a failed shift.
 float target_from(ReuseInput l, PathRecord y) {
     if (same_domain(inputs[0].domain, l.domain)) return target_function(y.contribution);
-    ShiftResult s = shift_path(y, inputs[0].domain, l.domain);
+    ShiftResult s = shift_path(y, l.domain);
     if (!s.valid) return 0.0;
     float t = target_function(s.contribution) * s.jacobian;
     if (!is_finite(t)) {
@@ -160,7 +160,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         float jacobian = 1.0;
         bool shifted_in = !same_domain(inputs[i].domain, inputs[0].domain);
         if (shifted_in) {
-            ShiftResult shifted = shift_path(y, inputs[i].domain, inputs[0].domain);
+            ShiftResult shifted = shift_path(y, inputs[0].domain);
             if (!shifted.valid) continue;
             y = shifted.record;
             jacobian = shifted.jacobian;
