@@ -26,7 +26,7 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
     uint neighbours;         // spatial neighbours per round
     uint temporal_valid;     // 1 if the previous frame's reservoirs and surfaces exist
     uint emission_rays;      // camera rays per pixel for the emission seen at the primary hit
-    uint pad1;
+    uint reservoirs;         // independent reservoirs per pixel (see reservoir_index)
 };
 
 // The primary hit of a pixel in one frame: the domain of that pixel's paths.
@@ -69,6 +69,16 @@ layout(push_constant) uniform RestirPass {
     uint surface_slot;   // the current frame's surfaces; the previous frame's are the other slot
     uint pass_seed;      // distinguishes the random choices of passes and rounds
 };
+
+// A pixel keeps `reservoirs` independent reservoirs, each with its own paths, surface, history
+// and neighbours, and the pixel's estimate is their mean. Each reservoir's path is one colour
+// drawn in proportion to luminance, and that colour noise stays however many candidates one
+// reservoir resamples; independent reservoirs average it down. Reservoir `layer` of every pixel
+// forms one width x height layer of the per-reservoir buffers (surfaces, reservoirs, emission,
+// expectation); layer 0 alone is the one-reservoir layout.
+uint reservoir_index(uint pixel, uint layer) {
+    return layer * width * height + pixel;
+}
 
 // if/else rather than ?:, which glslang's optimiser mistypes for structs read from buffers.
 Surface load_surface(uint slot, uint pixel) {

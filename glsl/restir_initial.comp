@@ -33,7 +33,7 @@ vec3 pixel_emission(uvec2 p, uint seed, vec3 camera, vec3 first_dir, Hit first_h
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
-    uint pixel = p.y * width + p.x;
+    uint index = reservoir_index(p.y * width + p.x, gl_GlobalInvocationID.z);
     if (inside) {
         uint first = frame_index * candidates;
         vec3 camera = cam_position.xyz;
@@ -44,10 +44,10 @@ void main() {
         float scale = 1.0 / float(candidates);
         vec3 emission = vec3(0.0);
         // Each path has its own sub-pixel position, drawn from its seed (see Domain in
-        // restir_reuse.glsl); the first path's primary hit is the pixel's surface.
+        // restir_reuse.glsl); the first path's primary hit is the reservoir's surface.
         for (uint c = 0u; c < candidates; ++c) {
             loop_tick();
-            uint seed = path_seed(pixel, first + c, render_seed);
+            uint seed = path_seed(index, first + c, render_seed);
             vec4 jitter = rng_uniform4(seed, 0u, STREAM_CAMERA);
             vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
             Hit hit = trace_closest(camera, dir, SHIFT_RAY_TMAX);
@@ -58,10 +58,10 @@ void main() {
             stream_path_candidates(s, camera, y1, seed, max_length, params, scale);
         }
         s.confidence = float(candidates);
-        store_surface(surface_slot, pixel, surface);
-        direct[pixel] = vec4(emission, 0.0);
-        expectation[pixel] = vec4(s.expected, 0.0);
-        store_reservoir(out_slot, pixel, resampler_finish(s));
+        store_surface(surface_slot, index, surface);
+        direct[index] = vec4(emission, 0.0);
+        expectation[index] = vec4(s.expected, 0.0);
+        store_reservoir(out_slot, index, resampler_finish(s));
     }
     report_pass_stats();
 }

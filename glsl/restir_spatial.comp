@@ -11,13 +11,14 @@ layout(local_size_x = 8, local_size_y = 8) in;
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
-    uint pixel = p.y * width + p.x;
+    uint layer = gl_GlobalInvocationID.z;
+    uint index = reservoir_index(p.y * width + p.x, layer);
     if (inside) {
-        Reservoir canonical = load_reservoir(in_slot, pixel);
+        Reservoir canonical = load_reservoir(in_slot, index);
         Reservoir result = canonical;
-        Surface surface = load_surface(surface_slot, pixel);
+        Surface surface = load_surface(surface_slot, index);
         if (surface.triangle != NO_HIT) {
-            uint seed = path_seed(pixel, frame_index, render_seed ^ pass_seed);
+            uint seed = path_seed(index, frame_index, render_seed ^ pass_seed);
             inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
             uint n = 1u;
             for (uint j = 0u; j < min(neighbours, MAX_INPUTS - 1u); ++j) {
@@ -27,7 +28,7 @@ void main() {
                 float phi = 2.0 * PI * u.y;
                 ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(phi), sin(phi))));
                 if (q.x < 0 || q.y < 0 || q.x >= int(width) || q.y >= int(height) || all(equal(uvec2(q), p))) continue;
-                uint neighbour = uint(q.y) * width + uint(q.x);
+                uint neighbour = reservoir_index(uint(q.y) * width + uint(q.x), layer);
                 Surface other = load_surface(surface_slot, neighbour);
                 if (!similar_surfaces(surface, other)) continue;
                 Reservoir res = load_reservoir(in_slot, neighbour);
@@ -36,9 +37,9 @@ void main() {
             }
             vec3 expected;
             result = resample_inputs(n, seed, expected);
-            expectation[pixel] = vec4(expected, 0.0);
+            expectation[index] = vec4(expected, 0.0);
         }
-        store_reservoir(out_slot, pixel, result);
+        store_reservoir(out_slot, index, result);
     }
     report_pass_stats();
 }

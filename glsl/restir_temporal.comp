@@ -2,7 +2,8 @@
 // ReSTIR PT pass 2: temporal reuse. The pixel's primary hit is reprojected into the previous
 // frame's camera (an unmoved camera keeps the pixel); that pixel's final reservoir is shifted
 // into this pixel's domain and resampled with this pixel's initial reservoir, its confidence
-// capped at m_cap times the current M.
+// capped at m_cap times the current M. Compiled twice: with CANONICAL_DOMAIN_ONLY for an
+// unmoved camera, without shifts (restir_reuse.glsl), and as is for a moving one.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -25,30 +26,36 @@ bool reproject(vec3 pos, out uint pixel) {
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
-    uint pixel = p.y * width + p.x;
+    uint layer = gl_GlobalInvocationID.z;
+    uint index = reservoir_index(p.y * width + p.x, layer);
     if (inside) {
-        Reservoir canonical = load_reservoir(in_slot, pixel);
+        Reservoir canonical = load_reservoir(in_slot, index);
         Reservoir result = canonical;
-        Surface surface = load_surface(surface_slot, pixel);
+        Surface surface = load_surface(surface_slot, index);
         // An unmoved camera sees the pixel's own domain again, whatever its jittered hits: the
         // history is taken as it is (reprojecting this frame's hit could round into a neighbour
         // at the pixel's edge, and an edge pixel's two hits may lie on different surfaces).
+#ifdef CANONICAL_DOMAIN_ONLY
+        // The host compiles this variant for frames whose camera did not move.
+        bool unmoved = true;
+#else
         bool unmoved = same_pose(previous_camera(), frame_camera());
-        uint prev_pixel = pixel;
+#endif
+        uint prev_pixel = p.y * width + p.x;
         bool reusable = unmoved;
         if (!unmoved && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
-            reusable = similar_surfaces(surface, load_surface(1u - surface_slot, prev_pixel));
+            reusable = similar_surfaces(surface, load_surface(1u - surface_slot, reservoir_index(prev_pixel, layer)));
         }
         if (temporal_valid != 0u && reusable) {
             inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
-            Reservoir prev = load_reservoir(prev_slot, prev_pixel);
+            Reservoir prev = load_reservoir(prev_slot, reservoir_index(prev_pixel, layer));
             float confidence = min(prev.M, m_cap * canonical.M);
             inputs[1] = ReuseInput(prev, Domain(uvec2(prev_pixel % width, prev_pixel / width), true), confidence);
             vec3 expected;
-            result = resample_inputs(2u, path_seed(pixel, frame_index, render_seed ^ pass_seed), expected);
-            expectation[pixel] = vec4(expected, 0.0);
+            result = resample_inputs(2u, path_seed(index, frame_index, render_seed ^ pass_seed), expected);
+            expectation[index] = vec4(expected, 0.0);
         }
-        store_reservoir(out_slot, pixel, result);
+        store_reservoir(out_slot, index, result);
     }
     report_pass_stats();
 }

@@ -119,7 +119,7 @@ pub struct ReuseParams {
     pub neighbours: u32,
     pub temporal_valid: u32,
     pub emission_rays: u32,
-    pub pad1: u32,
+    pub reservoirs: u32,
 }
 
 /// A pixel's primary hit in one frame (glsl/restir_bindings.glsl).

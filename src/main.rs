@@ -97,9 +97,14 @@ struct RestirOpts {
     /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M.
     #[arg(long, default_value_t = 20.0)]
     m_cap: f32,
-    /// ReSTIR PT: initial paths traced per pixel and frame.
+    /// ReSTIR PT: initial paths traced per reservoir and frame.
     #[arg(long, default_value_t = 1)]
     candidates: u32,
+    /// ReSTIR PT: independent reservoirs per pixel (1 to 16), each with its own paths, history
+    /// and neighbours; the pixel shows their mean, which averages down the colour noise of
+    /// one luminance-resampled path.
+    #[arg(long, default_value_t = 1)]
+    reservoirs: u32,
     /// ReSTIR PT: camera rays per pixel and frame that estimate the emission seen directly
     /// (1: only the reservoir's primary ray); each further ray costs one closest-hit trace.
     #[arg(long, default_value_t = RestirSettings::default().emission_rays)]
@@ -124,6 +129,7 @@ impl RestirOpts {
             rounds: self.rounds,
             m_cap: self.m_cap,
             candidates: self.candidates,
+            reservoirs: self.reservoirs,
             emission_rays: self.emission_rays,
             ..Default::default()
         }
@@ -271,7 +277,7 @@ struct CompareCmd {
     #[arg(long, value_delimiter = ',', default_value = "pt,restir:reconnection,restir:replay,restir:hybrid")]
     methods: Vec<String>,
     /// GPU ms per frame (default: ReSTIR PT's cheapest frame times 1.05, 2.1 and 4.2). Each method
-    /// spends a budget on path-tracer spp or ReSTIR PT candidates.
+    /// spends a budget on path-tracer spp or ReSTIR PT reservoirs per pixel (each with --candidates paths).
     #[arg(long, value_delimiter = ',')]
     budgets_ms: Vec<f64>,
     /// Frames of a static camera per run; the error is measured on the last frame alone.

@@ -13,14 +13,14 @@ use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceAr
 use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
 use crate::image_io::read_exr;
 use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, rel_squared_error, TRIMMED_SHARE};
-use crate::render::{Image, RenderSettings, RestirSettings, MAX_CANDIDATES};
+use crate::render::{Image, RenderSettings, RestirSettings, MAX_RESERVOIRS};
 use crate::scene::Scene;
 
 pub struct CompareArgs {
     pub scene: PathBuf,
     pub reference: PathBuf,
     pub methods: Vec<String>,
-    /// GPU ms per frame; empty: ReSTIR PT's one-candidate frame cost times 1, 2 and 4.
+    /// GPU ms per frame; empty: ReSTIR PT's one-reservoir frame cost times 1, 2 and 4.
     pub budgets_ms: Vec<f64>,
     /// Frames per run (static camera); the error is the last frame's.
     pub frames: u32,
@@ -38,7 +38,7 @@ pub struct CompareArgs {
 pub struct CompareRow {
     pub method: String,
     pub budget_ms: f64,
-    /// The cost knob chosen to fit the budget: path-tracer spp or ReSTIR PT candidates.
+    /// The cost knob chosen to fit the budget: path-tracer spp or ReSTIR PT reservoirs.
     pub knob: String,
     pub gpu_ms_per_frame: f64,
     pub rel_mse: f64,
@@ -52,27 +52,30 @@ pub struct CompareRow {
 
 /// A method's frame cost, measured after its kernels are compiled.
 enum Cost {
-    /// GPU ms per path-traced sample per pixel.
-    PerSample(f64),
-    /// ReSTIR PT: GPU ms of a frame with one candidate, and per extra candidate.
-    Frame { base: f64, per_candidate: f64 },
+    /// Path tracing: GPU ms per frame of its own and per sample per pixel. A frame's fixed cost
+    /// (about 7 ms, cornell-glossy at 64x64 on llvmpipe) is not small beside a sample (about 6 ms): a cost of
+    /// 8 spp over 8 gave 2 spp a 21 ms budget and they took 30 ms.
+    Affine { fixed: f64, per_sample: f64 },
+    /// ReSTIR PT: GPU ms per frame with 1, 2, ... reservoirs per pixel, each measured: a
+    /// straight line through 1 and 4 reservoirs once gave 2 reservoirs where 3 fitted, their
+    /// cost not being linear (cornell-glossy, 64x64: 14.5 ms for one, 67 ms for four).
+    PerReservoirs(Vec<f64>),
 }
 
 impl Cost {
     /// The knob value that fits `budget_ms`, or None if even the cheapest frame does not.
     fn fit(&self, budget_ms: f64) -> Option<u32> {
-        match *self {
-            Cost::PerSample(ms) => Some(((budget_ms / ms).floor() as u32).max(1)),
-            Cost::Frame { base, per_candidate } => {
-                if base > budget_ms {
-                    return None;
-                }
-                let extra = ((budget_ms - base) / per_candidate.max(1e-6)).floor() as u32;
-                Some((1 + extra).min(MAX_CANDIDATES))
-            }
+        match self {
+            Cost::Affine { fixed, per_sample } => Some((((budget_ms - fixed) / per_sample).floor().max(1.0)) as u32),
+            Cost::PerReservoirs(ms) => ms.iter().rposition(|&t| t <= budget_ms).map(|i| i as u32 + 1),
         }
     }
 }
+
+/// Frames per cost measurement, whose median is taken: on a shared machine single frames of
+/// one setting vary by half (cornell-glossy, 64x64: 14.4 to 21.5 ms), and a cost read from
+/// three frames once filled half a budget.
+const CALIBRATION_FRAMES: u32 = 8;
 
 struct Run<'a> {
     scene: &'a Scene,
@@ -111,35 +114,71 @@ impl Run<'_> {
         })
     }
 
-    /// Measures a method's frame cost. The first run compiles the kernels (llvmpipe compiles at
-    /// the first dispatch) and is not counted.
+    /// Measures a method's frame cost: the path tracer's per sample, ReSTIR PT's with one
+    /// reservoir. The first run compiles the kernels (llvmpipe compiles at the first dispatch)
+    /// and is not counted.
     fn calibrate(&self, renderer: &mut MethodRenderer) -> Result<Cost> {
         match renderer {
             MethodRenderer::PathTracing(..) => {
                 renderer.set_cost_knob(1)?;
                 self.sequence(renderer, 1, 0)?;
+                let one = self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame;
                 const SAMPLES: u32 = 8;
                 renderer.set_cost_knob(SAMPLES)?;
-                let ms = self.sequence(renderer, 1, 0)?.gpu_ms_per_frame;
-                Ok(Cost::PerSample(ms / SAMPLES as f64))
-            }
-            MethodRenderer::Restir(_) => {
-                // The slope comes from 1 and 4 candidates. From 1 and 2 it once read under 5% of
-                // a frame where a candidate cost about 9 ms (veach-door, 8 pairwise
-                // neighbours), and a 127 ms budget was spent as 23 candidates at 255 ms.
-                const FRAMES: u32 = 4;
-                const MORE: u32 = 4;
-                renderer.set_cost_knob(1)?;
-                self.sequence(renderer, FRAMES, 0)?;
-                let base = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
-                renderer.set_cost_knob(MORE)?;
-                let more = self.sequence(renderer, FRAMES, 0)?.gpu_ms_per_frame;
-                Ok(Cost::Frame {
-                    base,
-                    per_candidate: ((more - base) / (MORE - 1) as f64).max(0.05 * base),
+                let more = self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame;
+                let per_sample = ((more - one) / (SAMPLES - 1) as f64).max(0.1 * more / SAMPLES as f64);
+                Ok(Cost::Affine {
+                    fixed: (one - per_sample).max(0.0),
+                    per_sample,
                 })
             }
+            MethodRenderer::Restir(_) => {
+                renderer.set_cost_knob(1)?;
+                self.sequence(renderer, CALIBRATION_FRAMES, 0)?;
+                Ok(Cost::PerReservoirs(vec![
+                    self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame,
+                ]))
+            }
         }
+    }
+
+    /// The cost model is measured before the runs, and a shared machine's speed drifts (the path
+    /// tracer's 10 spp, fitted to 65 ms, once took 84 ms; 2 reservoirs fitted to 40 ms took 27):
+    /// short runs move `knob` in proportion to the budget over their time, down while they
+    /// overrun `budget_ms`, up while one more unit would fit, never back to a knob that overran.
+    /// Returns the knob, set.
+    fn fit_to_budget(&self, renderer: &mut MethodRenderer, mut knob: u32, budget_ms: f64, frames: u32) -> Result<u32> {
+        let check_frames = CALIBRATION_FRAMES.min(frames.max(2));
+        let mut overran = renderer.max_cost_knob() + 1;
+        knob = knob.min(renderer.max_cost_knob());
+        loop {
+            renderer.set_cost_knob(knob)?;
+            let ms = self.sequence(renderer, check_frames, 0)?.gpu_ms_per_frame;
+            let scaled = (knob as f64 * budget_ms / ms).floor() as u32;
+            if ms > budget_ms {
+                overran = knob;
+                if knob == 1 {
+                    return Ok(knob);
+                }
+                knob = scaled.clamp(1, knob - 1);
+            } else if knob + 1 < overran && ms * (knob + 1) as f64 / knob as f64 <= budget_ms {
+                knob = scaled.clamp(knob + 1, overran - 1);
+            } else {
+                return Ok(knob);
+            }
+        }
+    }
+
+    /// Measures ReSTIR PT frames with more reservoirs until one costs over `max_budget_ms` or
+    /// the most reservoirs are measured.
+    fn extend(&self, renderer: &mut MethodRenderer, cost: &mut Cost, max_budget_ms: f64) -> Result<()> {
+        if let Cost::PerReservoirs(ms) = cost {
+            while ms.last().is_some_and(|&t| t <= max_budget_ms) && ms.len() < MAX_RESERVOIRS as usize {
+                renderer.set_cost_knob(ms.len() as u32 + 1)?;
+                ms.push(self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame);
+            }
+        }
+        Ok(())
     }
 }
 
@@ -242,8 +281,8 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
         let cheapest_restir = renderers
             .iter()
             .filter_map(|(_, _, c)| match c {
-                Cost::Frame { base, .. } => Some(*base),
-                Cost::PerSample(_) => None,
+                Cost::PerReservoirs(ms) => Some(ms[0]),
+                Cost::Affine { .. } => None,
             })
             .fold(f64::INFINITY, f64::min);
         let unit = if cheapest_restir.is_finite() {
@@ -256,6 +295,11 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
         args.budgets_ms.clone()
     };
 
+    let max_budget = budgets.iter().copied().fold(0.0, f64::max);
+    for (_, renderer, cost) in &mut renderers {
+        run.extend(renderer, cost, max_budget)?;
+    }
+
     let mut rows = vec![];
     let mut images: Vec<(String, f64, Image)> = vec![];
     for (label, renderer, cost) in &mut renderers {
@@ -264,7 +308,7 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
                 eprintln!("{label}: skipped at {budget:.1} ms, its cheapest frame does not fit");
                 continue;
             };
-            renderer.set_cost_knob(knob)?;
+            let knob = run.fit_to_budget(renderer, knob, budget, args.frames)?;
             let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
             let mut last = None;
             for t in 0..args.trials {

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use anyhow::{bail, Result};
 
-use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind};
+use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
 use crate::scene::Scene;
 use crate::vk::Context;
 
@@ -69,6 +69,9 @@ pub fn parse_methods(list: &[String], base: &RestirSettings) -> Result<Vec<Metho
     list.iter().map(|m| MethodSpec::parse(m, base)).collect()
 }
 
+/// The most samples per pixel a path-traced frame of `compare` or `stability` takes.
+const MAX_FRAME_SPP: u32 = 1 << 16;
+
 /// A compiled renderer for one method; its kernels are reused across runs.
 pub enum MethodRenderer {
     /// The path tracer and its paths per pixel and frame. Both renderers are boxed: each holds
@@ -101,25 +104,33 @@ impl MethodRenderer {
         }
     }
 
-    /// Sets the frame-cost knob: the path tracer's paths per pixel, or ReSTIR PT's initial
-    /// candidates per pixel.
+    /// Sets the frame-cost knob: the path tracer's paths per pixel, or ReSTIR PT's reservoirs
+    /// per pixel (its candidates per reservoir stay as set).
     pub fn set_cost_knob(&mut self, value: u32) -> Result<()> {
         match self {
             MethodRenderer::PathTracing(_, spp) => {
-                if value == 0 {
-                    bail!("a path-traced frame needs at least 1 sample per pixel");
+                if !(1..=MAX_FRAME_SPP).contains(&value) {
+                    bail!("a path-traced frame takes 1 to {MAX_FRAME_SPP} samples per pixel, not {value}");
                 }
                 *spp = value;
                 Ok(())
             }
-            MethodRenderer::Restir(r) => r.set_candidates(value),
+            MethodRenderer::Restir(r) => r.set_reservoirs(value),
+        }
+    }
+
+    /// The largest value set_cost_knob takes.
+    pub fn max_cost_knob(&self) -> u32 {
+        match self {
+            MethodRenderer::PathTracing(..) => MAX_FRAME_SPP,
+            MethodRenderer::Restir(_) => MAX_RESERVOIRS,
         }
     }
 
     pub fn cost_knob_name(&self) -> &'static str {
         match self {
             MethodRenderer::PathTracing(..) => "spp",
-            MethodRenderer::Restir(_) => "candidates",
+            MethodRenderer::Restir(_) => "reservoirs",
         }
     }
 

@@ -339,11 +339,11 @@ fn render_restir(
             method: restir.label(),
             width: settings.width,
             height: settings.height,
-            spp: restir.candidates,
+            spp: restir.candidates * restir.reservoirs,
             max_depth: settings.max_depth,
             gpu_ms: frame_ms,
             wall_ms: stats.wall_ms,
-            paths_per_second: settings.pixel_count() as f64 * restir.candidates as f64 / (frame_ms * 1e-3),
+            paths_per_second: settings.pixel_count() as f64 * (restir.candidates * restir.reservoirs) as f64 / (frame_ms * 1e-3),
             restir: Some(detail.clone()),
         };
         println!(

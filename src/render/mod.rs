@@ -2,6 +2,7 @@
 
 mod image;
 mod path_tracer;
+mod reservoir_layers;
 mod restir;
 mod restir_settings;
 mod scene_gpu;
@@ -10,6 +11,6 @@ mod settings;
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir, PASS_NAMES};
-pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_ROUNDS};
+pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
 pub use scene_gpu::SceneGpu;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};

@@ -6,18 +6,19 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 
+use super::reservoir_layers::{ReservoirLayers, RESERVOIR_SLOTS};
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
-use crate::gpu_types::{FrameParams, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface};
+use crate::gpu_types::{FrameParams, RestirPass, RestirStats, ReuseParams};
 use crate::scene::Scene;
 use crate::shift::ShiftParams;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
 
 const LOCAL_SIZE: u32 = 8;
-const RESERVOIR_SLOTS: usize = 3;
 
 /// The passes of a frame, in order; their GPU times are reported under these names.
 pub const PASS_NAMES: [&str; 4] = ["initial", "temporal", "spatial", "shade"];
+const SHADE_PASS: usize = 3;
 
 /// GPU milliseconds per pass of one frame (indexed like PASS_NAMES); None without timestamps.
 #[derive(Debug, Clone)]
@@ -47,19 +48,17 @@ pub struct Restir {
     ctx: Arc<Context>,
     initial: Kernel,
     temporal: Kernel,
+    /// Temporal reuse for frames whose camera did not move: nothing is shifted.
+    temporal_unmoved: Kernel,
     spatial: Kernel,
     shade: Kernel,
     params: Buffer,
     reuse: Buffer,
-    _surfaces: [Buffer; 2],
-    _heads: [Buffer; RESERVOIR_SLOTS],
-    _tails: [Buffer; RESERVOIR_SLOTS],
-    _direct: Buffer,
-    _expectation: Buffer,
+    layers: ReservoirLayers,
     accum: Buffer,
     accum_sq: Buffer,
     stats: Buffer,
-    _scene_gpu: SceneGpu,
+    scene_gpu: SceneGpu,
     timer: PassTimer,
     settings: RenderSettings,
     restir: RestirSettings,
@@ -75,10 +74,8 @@ impl Restir {
         settings.validate(scene)?;
         restir.validate(settings.max_depth)?;
         let pixels = settings.pixel_count() as u64;
-        let half = std::mem::size_of::<ReservoirHead>() as u64;
-        ctx.check_binding_size("a reservoir half", pixels * half)?;
-        ctx.check_binding_size("the surfaces", pixels * std::mem::size_of::<Surface>() as u64)?;
         ctx.check_binding_size("the accumulation image", pixels * 16)?;
+        let layers = ReservoirLayers::new(ctx, pixels, restir.reservoirs)?;
         let scene_gpu = SceneGpu::upload(ctx, scene)?;
         let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
         let params = Buffer::new(
@@ -93,70 +90,44 @@ impl Restir {
             std::mem::size_of::<ReuseParams>() as u64,
             BufferUsage::Uniform,
         )?;
-        let surfaces = [
-            storage("surfaces 0", pixels * std::mem::size_of::<Surface>() as u64)?,
-            storage("surfaces 1", pixels * std::mem::size_of::<Surface>() as u64)?,
-        ];
-        let tail = std::mem::size_of::<ReservoirTail>() as u64;
-        let heads = [
-            storage("reservoir heads 0", pixels * half)?,
-            storage("reservoir heads 1", pixels * half)?,
-            storage("reservoir heads 2", pixels * half)?,
-        ];
-        let tails = [
-            storage("reservoir tails 0", pixels * tail)?,
-            storage("reservoir tails 1", pixels * tail)?,
-            storage("reservoir tails 2", pixels * tail)?,
-        ];
-        let direct = storage("primary emission", pixels * 16)?;
         let accum = storage("accumulation", pixels * 16)?;
         let accum_sq = storage("accumulation of squares", pixels * 16)?;
         let stats = storage("ReSTIR statistics", std::mem::size_of::<RestirStats>() as u64)?;
-        let expectation = storage("resampled expectation", pixels * 16)?;
 
         let mut bindings = scene_gpu.bindings();
         bindings.push(Binding::Uniform);
         bindings.extend([Binding::Storage; 13]);
-        let mut buffers = scene_gpu.buffers(&params);
-        buffers.push(&reuse);
-        buffers.extend(surfaces.iter());
-        for (h, t) in heads.iter().zip(&tails) {
-            buffers.extend([h, t]);
-        }
-        buffers.extend([&direct, &accum, &accum_sq, &stats, &expectation]);
         let mut defines = scene_gpu.defines();
         defines.extend(restir.defines());
         let push = std::mem::size_of::<RestirPass>() as u32;
-        let kernel = |name: &str| -> Result<Kernel> {
-            let k = Kernel::new(ctx, name, &defines, &bindings, push)?;
-            k.bind(&buffers);
-            Ok(k)
+        let kernel_with = |name: &str, extra: &[(&'static str, &'static str)]| -> Result<Kernel> {
+            let all: Vec<_> = defines.iter().chain(extra).copied().collect();
+            Kernel::new(ctx, name, &all, &bindings, push)
         };
-        let (initial, temporal, spatial, shade) = (
+        let kernel = |name: &str| kernel_with(name, &[]);
+        let (initial, temporal, temporal_unmoved, spatial, shade) = (
             kernel("restir_initial.comp")?,
             kernel("restir_temporal.comp")?,
+            kernel_with("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")])?,
             kernel("restir_spatial.comp")?,
             kernel("restir_shade.comp")?,
         );
         accum.fill(0)?;
         accum_sq.fill(0)?;
-        Ok(Self {
+        let restir = Self {
             ctx: ctx.clone(),
             initial,
             temporal,
+            temporal_unmoved,
             spatial,
             shade,
             params,
             reuse,
-            _surfaces: surfaces,
-            _heads: heads,
-            _tails: tails,
-            _direct: direct,
-            _expectation: expectation,
+            layers,
             accum,
             accum_sq,
             stats,
-            _scene_gpu: scene_gpu,
+            scene_gpu,
             timer: PassTimer::new(ctx, PASS_NAMES.len() as u32)?,
             settings: settings.clone(),
             restir: restir.clone(),
@@ -164,7 +135,24 @@ impl Restir {
             frame_index: 0,
             history: None,
             surface_slot: 0,
-        })
+        };
+        restir.bind_buffers();
+        Ok(restir)
+    }
+
+    /// Points every kernel's descriptors at the current buffers.
+    fn bind_buffers(&self) {
+        let layers = &self.layers;
+        let mut buffers = self.scene_gpu.buffers(&self.params);
+        buffers.push(&self.reuse);
+        buffers.extend(layers.surfaces.iter());
+        for (h, t) in layers.heads.iter().zip(&layers.tails) {
+            buffers.extend([h, t]);
+        }
+        buffers.extend([&layers.direct, &self.accum, &self.accum_sq, &self.stats, &layers.expectation]);
+        for kernel in [&self.initial, &self.temporal, &self.temporal_unmoved, &self.spatial, &self.shade] {
+            kernel.bind(&buffers);
+        }
     }
 
     /// Forgets the temporal history and the accumulated average; the next frame starts a new,
@@ -178,14 +166,19 @@ impl Restir {
         Ok(())
     }
 
-    /// Changes the initial paths per pixel of the next frames (a frame-cost knob; the kernels
-    /// stay compiled).
-    pub fn set_candidates(&mut self, candidates: u32) -> Result<()> {
+    /// Changes the reservoirs per pixel of the next frames (a frame-cost knob; the kernels stay
+    /// compiled, the per-reservoir buffers are made anew). The history is forgotten.
+    pub fn set_reservoirs(&mut self, reservoirs: u32) -> Result<()> {
         let restir = RestirSettings {
-            candidates,
+            reservoirs,
             ..self.restir.clone()
         };
         restir.validate(self.settings.max_depth)?;
+        if reservoirs != self.restir.reservoirs {
+            self.layers = ReservoirLayers::new(&self.ctx, self.settings.pixel_count() as u64, reservoirs)?;
+            self.bind_buffers();
+            self.history = None;
+        }
         self.restir = restir;
         Ok(())
     }
@@ -218,7 +211,7 @@ impl Restir {
             neighbours: self.restir.spatial,
             temporal_valid: (self.restir.temporal && self.history.is_some()) as u32,
             emission_rays: self.restir.emission_rays,
-            ..Default::default()
+            reservoirs: self.restir.reservoirs,
         };
         self.reuse.write(std::slice::from_ref(&reuse))?;
 
@@ -237,19 +230,28 @@ impl Restir {
         let mut passes: Vec<(&Kernel, usize, RestirPass)> = vec![(&self.initial, 0, pass(0, work[0], 0))];
         let mut current = 0;
         if reuse.temporal_valid != 0 {
-            passes.push((&self.temporal, 1, pass(work[current], work[1 - current], 0x7e3a_11c5)));
+            let temporal = if same_pose(&prev, &frame_params) {
+                &self.temporal_unmoved
+            } else {
+                &self.temporal
+            };
+            passes.push((temporal, 1, pass(work[current], work[1 - current], 0x7e3a_11c5)));
             current = 1 - current;
         }
         for round in 0..self.restir.spatial_rounds() {
             passes.push((&self.spatial, 2, pass(work[current], work[1 - current], 0x5bd1_e995 ^ (round + 1))));
             current = 1 - current;
         }
-        passes.push((&self.shade, 3, pass(work[current], work[current], 0)));
-        let groups = [
-            self.settings.width.div_ceil(LOCAL_SIZE),
-            self.settings.height.div_ceil(LOCAL_SIZE),
-            1,
-        ];
+        passes.push((&self.shade, SHADE_PASS, pass(work[current], work[current], 0)));
+        // Every pass but shading runs once per reservoir (the z dimension); shading averages a
+        // pixel's reservoirs.
+        let groups = |slot: usize| {
+            [
+                self.settings.width.div_ceil(LOCAL_SIZE),
+                self.settings.height.div_ceil(LOCAL_SIZE),
+                if slot == SHADE_PASS { 1 } else { self.restir.reservoirs },
+            ]
+        };
         self.ctx
             .submit_and_wait(|cmd| {
                 self.stats.record_fill(cmd, 0);
@@ -268,7 +270,7 @@ impl Restir {
                         self.timer.record_begin(cmd, *slot as u32);
                         open = Some(*slot);
                     }
-                    kernel.record_dispatch(cmd, groups, bytemuck::bytes_of(push));
+                    kernel.record_dispatch(cmd, groups(*slot), bytemuck::bytes_of(push));
                     record_compute_barrier(&self.ctx.device, cmd);
                 }
                 if let Some(s) = open {
@@ -307,4 +309,9 @@ impl Restir {
     pub fn image(&self) -> Result<Image> {
         Ok(Image::read_accumulation(&self.settings, &self.accum, &self.accum_sq)?)
     }
+}
+
+/// Whether two frames share a camera pose, compared as glsl/restir_reuse.glsl's same_pose does.
+fn same_pose(a: &FrameParams, b: &FrameParams) -> bool {
+    a.cam_position == b.cam_position && a.cam_right == b.cam_right && a.cam_up == b.cam_up && a.cam_forward == b.cam_forward
 }

@@ -62,6 +62,7 @@ pub const MAX_NEIGHBOURS: u32 = 8;
 pub const MAX_ROUNDS: u32 = 3;
 pub const MAX_CANDIDATES: u32 = 64;
 pub const MAX_EMISSION_RAYS: u32 = 64;
+pub const MAX_RESERVOIRS: u32 = 16;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct RestirSettings {
@@ -74,8 +75,13 @@ pub struct RestirSettings {
     pub rounds: u32,
     /// The temporal input's confidence is capped at m_cap times the current M.
     pub m_cap: f32,
-    /// Initial paths per pixel.
+    /// Initial paths per reservoir.
     pub candidates: u32,
+    /// Independent reservoirs per pixel, each with its own candidates, history and neighbours;
+    /// the pixel shows their mean. One reservoir holds one path, whose colour (drawn in
+    /// proportion to luminance) is noise that more candidates do not remove; more reservoirs
+    /// average it down.
+    pub reservoirs: u32,
     /// Camera rays per pixel that estimate the emission seen at the primary hit, the
     /// reservoir's own primary ray included. The emission term is estimated apart from the
     /// reservoir's paths, so extra rays cut its anti-aliasing noise (a light's edge seen by one
@@ -96,6 +102,7 @@ impl Default for RestirSettings {
             rounds: 1,
             m_cap: 20.0,
             candidates: 1,
+            reservoirs: 1,
             emission_rays: 4,
             normal_threshold: 0.9,
             depth_threshold: 0.1,
@@ -124,6 +131,12 @@ impl RestirSettings {
             bail!(
                 "--candidates {} is out of range: 1 to {MAX_CANDIDATES} paths per pixel",
                 self.candidates
+            );
+        }
+        if !(1..=MAX_RESERVOIRS).contains(&self.reservoirs) {
+            bail!(
+                "--reservoirs {} is out of range: 1 to {MAX_RESERVOIRS} reservoirs per pixel",
+                self.reservoirs
             );
         }
         if !(1..=MAX_EMISSION_RAYS).contains(&self.emission_rays) {

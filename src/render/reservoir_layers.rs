@@ -1,0 +1,49 @@
+//! The per-reservoir buffers of ReSTIR PT: one width x height layer per reservoir of a pixel
+//! (glsl/restir_bindings.glsl's reservoir_index).
+
+use std::sync::Arc;
+
+use anyhow::Result;
+
+use crate::gpu_types::{ReservoirHead, ReservoirTail, Surface};
+use crate::vk::{Buffer, BufferUsage, Context};
+
+pub const RESERVOIR_SLOTS: usize = 3;
+
+pub struct ReservoirLayers {
+    pub surfaces: [Buffer; 2],
+    pub heads: [Buffer; RESERVOIR_SLOTS],
+    pub tails: [Buffer; RESERVOIR_SLOTS],
+    /// The emission seen at each reservoir's primary hit.
+    pub direct: Buffer,
+    /// Each reservoir's expectation of f(Y) W_Y over its last resampling.
+    pub expectation: Buffer,
+}
+
+impl ReservoirLayers {
+    pub fn new(ctx: &Arc<Context>, pixels: u64, reservoirs: u32) -> Result<Self> {
+        let entries = pixels * reservoirs as u64;
+        let half = std::mem::size_of::<ReservoirHead>() as u64;
+        let tail = std::mem::size_of::<ReservoirTail>() as u64;
+        let surface = std::mem::size_of::<Surface>() as u64;
+        let what = |name: &str| format!("{name} of {reservoirs} reservoir(s) per pixel");
+        ctx.check_binding_size(&what("a reservoir half"), entries * half.max(tail))?;
+        ctx.check_binding_size(&what("the surfaces"), entries * surface)?;
+        let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
+        Ok(Self {
+            surfaces: [storage("surfaces 0", entries * surface)?, storage("surfaces 1", entries * surface)?],
+            heads: [
+                storage("reservoir heads 0", entries * half)?,
+                storage("reservoir heads 1", entries * half)?,
+                storage("reservoir heads 2", entries * half)?,
+            ],
+            tails: [
+                storage("reservoir tails 0", entries * tail)?,
+                storage("reservoir tails 1", entries * tail)?,
+                storage("reservoir tails 2", entries * tail)?,
+            ],
+            direct: storage("primary emission", entries * 16)?,
+            expectation: storage("resampled expectation", entries * 16)?,
+        })
+    }
+}
