@@ -53,8 +53,8 @@ pub struct CompareRow {
 /// A method's frame cost, measured after its kernels are compiled.
 enum Cost {
     /// Path tracing: GPU ms per frame of its own and per sample per pixel. A frame's fixed cost
-    /// (about 7 ms, cornell-glossy at 64x64 on llvmpipe) is not small beside a sample (about 6 ms): a cost of
-    /// 8 spp over 8 gave 2 spp a 21 ms budget and they took 30 ms.
+    /// (about 7 ms, cornell-glossy at 64x64 on llvmpipe) is not small beside a sample (about
+    /// 6 ms): a cost of 8 spp over 8 gave 2 spp a 21 ms budget and they took 30 ms.
     Affine { fixed: f64, per_sample: f64 },
     /// ReSTIR PT: GPU ms per frame with 1, 2, ... reservoirs per pixel, each measured: a
     /// straight line through 1 and 4 reservoirs once gave 2 reservoirs where 3 fitted, their

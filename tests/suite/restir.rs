@@ -349,14 +349,15 @@ fn restir_unbiased_cornell() {
 
 // A static camera keeps each pixel's domain from frame to frame: temporal reuse takes the
 // previous reservoir unshifted (same_domain in glsl/restir_reuse.glsl), and only spatial reuse
-// shifts. Two configurations keep the test's time down; the identity is the same for all.
+// shifts. Two configurations keep the test's time down; the identity is the same for all. Two
+// reservoirs per pixel check that each keeps to its own layer's history and neighbours.
 #[test]
 fn restir_unbiased_cornell_static_camera() {
     check_unbiased(Unbiasedness {
         scene: "cornell",
         renders: RENDERS,
         candidates: 1,
-        reservoirs: 1,
+        reservoirs: 2,
         path_tracer_control: false,
         static_camera: true,
         configurations: &[
@@ -488,19 +489,23 @@ fn cornell_32_reference(ctx: &std::sync::Arc<restir_pt::vk::Context>) -> Vec<gla
     pt.image().unwrap().mean
 }
 
-/// The relMSE of frame 16 alone of a static camera, temporal reuse only, averaged over 4 seeds;
-/// asserts that no frame shifted a path. 64 emission rays keep the light's edge pixels, which
-/// reuse cannot help, out of the comparison.
-fn static_frame_16_rel_mse(ctx: &std::sync::Arc<restir_pt::vk::Context>, reference: &[glam::Vec3], temporal: bool, reservoirs: u32) -> f64 {
+/// A renderer of cornell_32_from_camera_0 without spatial reuse. 64 emission rays keep the
+/// light's edge pixels, which reuse cannot help, out of comparisons of frames.
+fn cornell_32_temporal_only(ctx: &std::sync::Arc<restir_pt::vk::Context>, temporal: bool) -> Restir {
     let (scene, small) = cornell_32_from_camera_0();
     let restir = RestirSettings {
         temporal,
         spatial: 0,
         emission_rays: 64,
-        reservoirs,
         ..Default::default()
     };
-    let mut renderer = Restir::new(ctx, &scene, &small, &restir).unwrap();
+    Restir::new(ctx, &scene, &small, &restir).unwrap()
+}
+
+/// The relMSE of `renderer`'s frame 16 alone of a static camera, averaged over 4 seeds; asserts
+/// that no frame shifted a path.
+fn static_frame_16_rel_mse(renderer: &mut Restir, reference: &[glam::Vec3]) -> f64 {
+    let (scene, _) = cornell_32_from_camera_0();
     let mut errors = vec![];
     for seed in 0..4 {
         renderer.reset(21 + seed).unwrap();
@@ -526,8 +531,8 @@ fn restir_static_camera_temporal_reuse_shifts_nothing_and_accumulates() {
     let ctx = gpu();
     let reference = cornell_32_reference(&ctx);
     let (without, with) = (
-        static_frame_16_rel_mse(&ctx, &reference, false, 1),
-        static_frame_16_rel_mse(&ctx, &reference, true, 1),
+        static_frame_16_rel_mse(&mut cornell_32_temporal_only(&ctx, false), &reference),
+        static_frame_16_rel_mse(&mut cornell_32_temporal_only(&ctx, true), &reference),
     );
     println!("frame 16 relMSE (mean of 4 seeds): {without:.4} without temporal reuse, {with:.4} with");
     assert!(with < without / 2.0, "temporal reuse: {with} against {without} without");
@@ -538,15 +543,15 @@ fn restir_static_camera_temporal_reuse_shifts_nothing_and_accumulates() {
 // frames of temporal reuse that colour is most of a frame's error, and more candidates do not
 // remove it. Four independent reservoirs per pixel must cut frame 16's relMSE at least
 // threefold (their mean has a quarter of the variance; measured 0.0083 against 0.0337 with one
-// reservoir, 4 seeds).
+// reservoir, 4 seeds). The renderer switches to four reservoirs in place, as `compare` does.
 #[test]
 fn restir_reservoirs_average_down_colour_noise() {
     let ctx = gpu();
     let reference = cornell_32_reference(&ctx);
-    let (one, four) = (
-        static_frame_16_rel_mse(&ctx, &reference, true, 1),
-        static_frame_16_rel_mse(&ctx, &reference, true, 4),
-    );
+    let mut renderer = cornell_32_temporal_only(&ctx, true);
+    let one = static_frame_16_rel_mse(&mut renderer, &reference);
+    renderer.set_reservoirs(4).unwrap();
+    let four = static_frame_16_rel_mse(&mut renderer, &reference);
     println!("frame 16 relMSE (mean of 4 seeds), temporal reuse: {one:.4} with 1 reservoir, {four:.4} with 4");
     assert!(four < one / 3.0, "4 reservoirs: {four} against {one} with 1");
     assert_clean(&ctx);
