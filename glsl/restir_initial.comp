@@ -1,7 +1,7 @@
 #version 460
-// ReSTIR PT pass 1: the pixel's primary hit (its surface and the emission seen there) and the
-// initial reservoir from `candidates` traced paths (restir_candidates.glsl), each through its own
-// sub-pixel position.
+// ReSTIR PT pass 1: the pixel's surface (its hit through the pixel's centre), the emission seen
+// directly and the initial reservoir from `candidates` traced paths (restir_candidates.glsl),
+// each through its own sub-pixel position.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -37,14 +37,20 @@ void main() {
     if (inside) {
         uint first = frame_index * candidates;
         vec3 camera = cam_position.xyz;
+        // The surface that picks temporal and spatial inputs is seen through the pixel's centre,
+        // not through a candidate's position: inputs chosen by a candidate's own hit would make
+        // the set of inputs, and so the MIS weights, depend on that candidate, and the canonical
+        // sample would no longer be distributed as its weight assumes (a bias at silhouettes).
+        Hit centre = trace_closest(camera, camera_ray_dir(float(p.x) + 0.5, float(p.y) + 0.5), SHIFT_RAY_TMAX);
         Surface surface = Surface(vec3(0.0), NO_HIT, camera, 0.0);
+        if (centre.triangle != NO_HIT) surface = Surface(hit_vertex(centre).pos, centre.triangle, camera, centre.t);
         Resampler s = resampler_begin();
         ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
         uint max_length = min(max_depth, MAX_PATH_LENGTH);
         float scale = 1.0 / float(candidates);
         vec3 emission = vec3(0.0);
         // Each path has its own sub-pixel position, drawn from its seed (see Domain in
-        // restir_reuse.glsl); the first path's primary hit is the reservoir's surface.
+        // restir_reuse.glsl).
         for (uint c = 0u; c < candidates; ++c) {
             loop_tick();
             uint seed = path_seed(index, first + c, render_seed);
@@ -54,7 +60,6 @@ void main() {
             if (c == 0u) emission = pixel_emission(p, seed, camera, dir, hit);
             if (hit.triangle == NO_HIT) continue;
             Vertex y1 = hit_vertex(hit);
-            if (c == 0u) surface = Surface(y1.pos, hit.triangle, camera, hit.t);
             stream_path_candidates(s, camera, y1, seed, max_length, params, scale);
         }
         s.confidence = float(candidates);
