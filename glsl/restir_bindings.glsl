@@ -29,7 +29,8 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
     uint reservoirs;         // independent reservoirs per pixel (see reservoir_index)
 };
 
-// The primary hit of a pixel in one frame: the domain of that pixel's paths.
+// A pixel's surface in one frame: the hit of the ray through its centre, from which temporal
+// and spatial reuse choose their inputs (restir_initial.comp says why not a candidate's hit).
 struct Surface {
     vec3 pos;
     uint triangle;   // NO_HIT: the camera ray escaped
@@ -70,8 +71,8 @@ layout(push_constant) uniform RestirPass {
     uint pass_seed;      // distinguishes the random choices of passes and rounds
 };
 
-// A pixel keeps `reservoirs` independent reservoirs, each with its own paths, surface, history
-// and neighbours, and the pixel's estimate is their mean. Each reservoir's path is one colour
+// A pixel keeps `reservoirs` independent reservoirs, each with its own paths, history and
+// neighbours, and the pixel's estimate is their mean. Each reservoir's path is one colour
 // drawn in proportion to luminance, and that colour noise stays however many candidates one
 // reservoir resamples; independent reservoirs average it down. Reservoir `layer` of every pixel
 // forms one width x height layer of the per-reservoir buffers (surfaces, reservoirs, emission,

@@ -1,8 +1,8 @@
 #version 460
-// ReSTIR PT pass 4: the pixel's estimate, the mean over its reservoirs of the emission seen at
-// the primary hit plus the last resampling's expectation of f(Y) W_Y (the same mean as
-// f(Y) W_Y, without the choice's noise), added to the accumulation (the average of a static camera's frames). Non-finite estimates are
-// counted, not clamped.
+// ReSTIR PT pass 4: the pixel's estimate, the mean over its reservoirs of the emission seen
+// directly plus the last resampling's expectation of f(Y) W_Y (the same mean as f(Y) W_Y,
+// without the choice's noise), added to the accumulation (the average of a static camera's
+// frames). Non-finite estimates are counted, not clamped.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 8, local_size_y = 8) in;
