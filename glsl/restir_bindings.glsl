@@ -31,6 +31,7 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
 
 // A pixel's surface in one frame: the hit of the ray through its centre, from which temporal
 // and spatial reuse choose their inputs (restir_initial.comp says why not a candidate's hit).
+// One per pixel, shared by the pixel's reservoirs.
 struct Surface {
     vec3 pos;
     uint triangle;   // NO_HIT: the camera ray escaped
@@ -75,7 +76,7 @@ layout(push_constant) uniform RestirPass {
 // neighbours, and the pixel's estimate is their mean. Each reservoir's path is one colour
 // drawn in proportion to luminance, and that colour noise stays however many candidates one
 // reservoir resamples; independent reservoirs average it down. Reservoir `layer` of every pixel
-// forms one width x height layer of the per-reservoir buffers (surfaces, reservoirs, emission,
+// forms one width x height layer of the per-reservoir buffers (reservoirs, emission,
 // expectation); layer 0 alone is the one-reservoir layout.
 uint reservoir_index(uint pixel, uint layer) {
     return layer * width * height + pixel;

@@ -33,7 +33,8 @@ vec3 pixel_emission(uvec2 p, uint seed, vec3 camera, vec3 first_dir, Hit first_h
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
-    uint index = reservoir_index(p.y * width + p.x, gl_GlobalInvocationID.z);
+    uint pixel = p.y * width + p.x;
+    uint index = reservoir_index(pixel, gl_GlobalInvocationID.z);
     if (inside) {
         uint first = frame_index * candidates;
         vec3 camera = cam_position.xyz;
@@ -41,9 +42,13 @@ void main() {
         // not through a candidate's position: inputs chosen by a candidate's own hit would make
         // the set of inputs, and so the MIS weights, depend on that candidate, and the canonical
         // sample would no longer be distributed as its weight assumes (a bias at silhouettes).
-        Hit centre = trace_closest(camera, camera_ray_dir(float(p.x) + 0.5, float(p.y) + 0.5), SHIFT_RAY_TMAX);
-        Surface surface = Surface(vec3(0.0), NO_HIT, camera, 0.0);
-        if (centre.triangle != NO_HIT) surface = Surface(hit_vertex(centre).pos, centre.triangle, camera, centre.t);
+        // The pixel's reservoirs share it; the first layer traces it.
+        if (gl_GlobalInvocationID.z == 0u) {
+            Hit centre = trace_closest(camera, camera_ray_dir(float(p.x) + 0.5, float(p.y) + 0.5), SHIFT_RAY_TMAX);
+            Surface surface = Surface(vec3(0.0), NO_HIT, camera, 0.0);
+            if (centre.triangle != NO_HIT) surface = Surface(hit_vertex(centre).pos, centre.triangle, camera, centre.t);
+            store_surface(surface_slot, pixel, surface);
+        }
         Resampler s = resampler_begin();
         ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
         uint max_length = min(max_depth, MAX_PATH_LENGTH);
@@ -63,7 +68,6 @@ void main() {
             stream_path_candidates(s, camera, y1, seed, max_length, params, scale);
         }
         s.confidence = float(candidates);
-        store_surface(surface_slot, index, surface);
         direct[index] = vec4(emission, 0.0);
         expectation[index] = vec4(s.expected, 0.0);
         store_reservoir(out_slot, index, resampler_finish(s));

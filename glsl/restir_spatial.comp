@@ -12,11 +12,12 @@ void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
     uint layer = gl_GlobalInvocationID.z;
-    uint index = reservoir_index(p.y * width + p.x, layer);
+    uint pixel = p.y * width + p.x;
+    uint index = reservoir_index(pixel, layer);
     if (inside) {
         Reservoir canonical = load_reservoir(in_slot, index);
         Reservoir result = canonical;
-        Surface surface = load_surface(surface_slot, index);
+        Surface surface = load_surface(surface_slot, pixel);
         if (surface.triangle != NO_HIT) {
             uint seed = path_seed(index, frame_index, render_seed ^ pass_seed);
             inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
@@ -28,10 +29,9 @@ void main() {
                 float phi = 2.0 * PI * u.y;
                 ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(phi), sin(phi))));
                 if (q.x < 0 || q.y < 0 || q.x >= int(width) || q.y >= int(height) || all(equal(uvec2(q), p))) continue;
-                uint neighbour = reservoir_index(uint(q.y) * width + uint(q.x), layer);
-                Surface other = load_surface(surface_slot, neighbour);
-                if (!similar_surfaces(surface, other)) continue;
-                Reservoir res = load_reservoir(in_slot, neighbour);
+                uint neighbour = uint(q.y) * width + uint(q.x);
+                if (!similar_surfaces(surface, load_surface(surface_slot, neighbour))) continue;
+                Reservoir res = load_reservoir(in_slot, reservoir_index(neighbour, layer));
                 inputs[n] = ReuseInput(res, Domain(uvec2(q), false), res.M);
                 n += 1u;
             }

@@ -27,11 +27,12 @@ void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     bool inside = p.x < width && p.y < height;
     uint layer = gl_GlobalInvocationID.z;
-    uint index = reservoir_index(p.y * width + p.x, layer);
+    uint pixel = p.y * width + p.x;
+    uint index = reservoir_index(pixel, layer);
     if (inside) {
         Reservoir canonical = load_reservoir(in_slot, index);
         Reservoir result = canonical;
-        Surface surface = load_surface(surface_slot, index);
+        Surface surface = load_surface(surface_slot, pixel);
         // An unmoved camera sees the pixel's own domain again, whatever its jittered hits: the
         // history is taken as it is (reprojecting this frame's hit could round into a neighbour
         // at the pixel's edge, and an edge pixel's two hits may lie on different surfaces).
@@ -41,10 +42,10 @@ void main() {
 #else
         bool unmoved = same_pose(previous_camera(), frame_camera());
 #endif
-        uint prev_pixel = p.y * width + p.x;
+        uint prev_pixel = pixel;
         bool reusable = unmoved;
         if (!unmoved && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
-            reusable = similar_surfaces(surface, load_surface(1u - surface_slot, reservoir_index(prev_pixel, layer)));
+            reusable = similar_surfaces(surface, load_surface(1u - surface_slot, prev_pixel));
         }
         if (temporal_valid != 0u && reusable) {
             inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);

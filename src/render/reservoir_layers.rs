@@ -5,13 +5,12 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use crate::gpu_types::{ReservoirHead, ReservoirTail, Surface};
+use crate::gpu_types::{ReservoirHead, ReservoirTail};
 use crate::vk::{Buffer, BufferUsage, Context};
 
 pub const RESERVOIR_SLOTS: usize = 3;
 
 pub struct ReservoirLayers {
-    pub surfaces: [Buffer; 2],
     pub heads: [Buffer; RESERVOIR_SLOTS],
     pub tails: [Buffer; RESERVOIR_SLOTS],
     /// The emission seen at each reservoir's primary hit.
@@ -25,13 +24,12 @@ impl ReservoirLayers {
         let entries = pixels * reservoirs as u64;
         let half = std::mem::size_of::<ReservoirHead>() as u64;
         let tail = std::mem::size_of::<ReservoirTail>() as u64;
-        let surface = std::mem::size_of::<Surface>() as u64;
-        let what = |name: &str| format!("{name} of {reservoirs} reservoir(s) per pixel");
-        ctx.check_binding_size(&what("a reservoir half"), entries * half.max(tail))?;
-        ctx.check_binding_size(&what("the surfaces"), entries * surface)?;
+        ctx.check_binding_size(
+            &format!("a reservoir half of {reservoirs} reservoir(s) per pixel"),
+            entries * half.max(tail),
+        )?;
         let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
         Ok(Self {
-            surfaces: [storage("surfaces 0", entries * surface)?, storage("surfaces 1", entries * surface)?],
             heads: [
                 storage("reservoir heads 0", entries * half)?,
                 storage("reservoir heads 1", entries * half)?,

@@ -9,7 +9,7 @@ use anyhow::{Context as _, Result};
 use super::reservoir_layers::{ReservoirLayers, RESERVOIR_SLOTS};
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
-use crate::gpu_types::{FrameParams, RestirPass, RestirStats, ReuseParams};
+use crate::gpu_types::{FrameParams, RestirPass, RestirStats, ReuseParams, Surface};
 use crate::scene::Scene;
 use crate::shift::ShiftParams;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
@@ -54,6 +54,9 @@ pub struct Restir {
     shade: Kernel,
     params: Buffer,
     reuse: Buffer,
+    /// Each pixel's surface (glsl/restir_bindings.glsl), this frame's and the previous one's,
+    /// shared by the pixel's reservoirs.
+    surfaces: [Buffer; 2],
     layers: ReservoirLayers,
     accum: Buffer,
     accum_sq: Buffer,
@@ -75,6 +78,8 @@ impl Restir {
         restir.validate(settings.max_depth)?;
         let pixels = settings.pixel_count() as u64;
         ctx.check_binding_size("the accumulation image", pixels * 16)?;
+        let surface_bytes = pixels * std::mem::size_of::<Surface>() as u64;
+        ctx.check_binding_size("the surfaces", surface_bytes)?;
         let layers = ReservoirLayers::new(ctx, pixels, restir.reservoirs)?;
         let scene_gpu = SceneGpu::upload(ctx, scene)?;
         let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
@@ -90,6 +95,7 @@ impl Restir {
             std::mem::size_of::<ReuseParams>() as u64,
             BufferUsage::Uniform,
         )?;
+        let surfaces = [storage("surfaces 0", surface_bytes)?, storage("surfaces 1", surface_bytes)?];
         let accum = storage("accumulation", pixels * 16)?;
         let accum_sq = storage("accumulation of squares", pixels * 16)?;
         let stats = storage("ReSTIR statistics", std::mem::size_of::<RestirStats>() as u64)?;
@@ -123,6 +129,7 @@ impl Restir {
             shade,
             params,
             reuse,
+            surfaces,
             layers,
             accum,
             accum_sq,
@@ -145,7 +152,7 @@ impl Restir {
         let layers = &self.layers;
         let mut buffers = self.scene_gpu.buffers(&self.params);
         buffers.push(&self.reuse);
-        buffers.extend(layers.surfaces.iter());
+        buffers.extend(self.surfaces.iter());
         for (h, t) in layers.heads.iter().zip(&layers.tails) {
             buffers.extend([h, t]);
         }
