@@ -27,6 +27,7 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
     uint temporal_valid;     // 1 if the previous frame's reservoirs and surfaces exist
     uint emission_rays;      // camera rays per pixel for the emission seen at the primary hit
     uint reservoirs;         // independent reservoirs per pixel (see reservoir_index)
+    uint emission_history;   // 1 if `direct` holds the running mean of the same camera pose
 };
 
 // A pixel's surface in one frame: the hit of the ray through its centre, from which temporal
@@ -47,7 +48,7 @@ layout(std430, set = 0, binding = 10) buffer Heads1 { ReservoirHead heads1[]; };
 layout(std430, set = 0, binding = 11) buffer Tails1 { ReservoirTail tails1[]; };
 layout(std430, set = 0, binding = 12) buffer Heads2 { ReservoirHead heads2[]; };
 layout(std430, set = 0, binding = 13) buffer Tails2 { ReservoirTail tails2[]; };
-layout(std430, set = 0, binding = 14) buffer Direct { vec4 direct[]; };     // rgb: emission seen at the primary hit
+layout(std430, set = 0, binding = 14) buffer Direct { vec4 direct[]; };     // rgb: emission seen directly, w: frames averaged
 layout(std430, set = 0, binding = 15) buffer Accum { vec4 accum[]; };       // rgb: sum of frames, w: count
 layout(std430, set = 0, binding = 16) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of squares
 layout(std430, set = 0, binding = 17) buffer RestirStats {

@@ -68,7 +68,16 @@ void main() {
             stream_path_candidates(s, camera, y1, seed, max_length, params, scale);
         }
         s.confidence = float(candidates);
-        direct[index] = vec4(emission, 0.0);
+        // Under an unmoved camera every frame estimates the same emission, so the estimate is
+        // the running mean over the frames since the camera last moved (unbiased however they
+        // are weighted), over at most m_cap frames, the temporal reservoir's cap.
+        float frames = 1.0;
+        if (emission_history != 0u) {
+            vec4 history = direct[index];
+            frames = min(history.w + 1.0, max(m_cap, 1.0));
+            emission = history.rgb + (emission - history.rgb) / frames;
+        }
+        direct[index] = vec4(emission, frames);
         expectation[index] = vec4(s.expected, 0.0);
         store_reservoir(out_slot, index, resampler_finish(s));
     }

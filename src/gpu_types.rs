@@ -120,6 +120,7 @@ pub struct ReuseParams {
     pub temporal_valid: u32,
     pub emission_rays: u32,
     pub reservoirs: u32,
+    pub emission_history: u32,
 }
 
 /// A pixel's primary hit in one frame (glsl/restir_bindings.glsl).

@@ -435,26 +435,19 @@ pub fn equal_time_lines(rows: &[CompareRow], budgets: &[f64]) -> Vec<String> {
                 .min_by(|a, b| error(a).total_cmp(&error(b)))
         };
         let plain: Error = |r| r.rel_mse;
-        if let (Some(pt), Some(best)) = (lowest(true, plain), lowest(false, plain)) {
-            lines.push(format!(
-                "equal time {budget:.1} ms: pt relMSE {:.4e} ({:.1} ms) / {} relMSE {:.4e} ({:.1} ms) = {:.2}x",
-                pt.rel_mse,
-                pt.gpu_ms_per_frame,
-                best.method,
-                best.rel_mse,
-                best.gpu_ms_per_frame,
-                pt.rel_mse / best.rel_mse
-            ));
-        }
         let trimmed: Error = |r| r.rel_mse_trimmed;
-        if let (Some(pt), Some(best)) = (lowest(true, trimmed), lowest(false, trimmed)) {
-            lines.push(format!(
-                "equal time {budget:.1} ms, trimmed relMSE: pt {:.4e} / {} {:.4e} = {:.2}x",
-                pt.rel_mse_trimmed,
-                best.method,
-                best.rel_mse_trimmed,
-                pt.rel_mse_trimmed / best.rel_mse_trimmed
-            ));
+        for (name, error) in [("relMSE", plain), ("trimmed relMSE", trimmed)] {
+            if let (Some(pt), Some(best)) = (lowest(true, error), lowest(false, error)) {
+                lines.push(format!(
+                    "equal time {budget:.1} ms, {name}: pt {:.4e} ({:.1} ms) / {} {:.4e} ({:.1} ms) = {:.2}x",
+                    error(pt),
+                    pt.gpu_ms_per_frame,
+                    best.method,
+                    error(best),
+                    best.gpu_ms_per_frame,
+                    error(pt) / error(best)
+                ));
+            }
         }
     }
     lines

@@ -219,6 +219,9 @@ impl Restir {
             temporal_valid: (self.restir.temporal && self.history.is_some()) as u32,
             emission_rays: self.restir.emission_rays,
             reservoirs: self.restir.reservoirs,
+            // Frames being accumulated are averaged already; a running mean inside them would
+            // only weigh the early frames' rays more.
+            emission_history: (self.restir.temporal && self.history.is_some() && same_pose(&prev, &frame_params) && !accumulate) as u32,
         };
         self.reuse.write(std::slice::from_ref(&reuse))?;
 

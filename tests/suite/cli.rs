@@ -335,7 +335,7 @@ fn cli_compare_writes_results_charts_and_strip() {
     let spp = |r: &Vec<&str>| r[2].trim_start_matches("spp=").parse::<u32>().unwrap();
     assert!(rows[0][0] == "pt" && rows[1][0] == "pt" && spp(&rows[1]) > spp(&rows[0]), "{csv}");
     assert!(rows[2][2].starts_with("reservoirs="), "{csv}");
-    assert!(stdout.contains("equal time 200.0 ms: pt relMSE"), "{stdout}");
+    assert!(stdout.contains("equal time 200.0 ms, relMSE: pt"), "{stdout}");
     assert!(stdout.contains("equal time 200.0 ms, trimmed relMSE: pt"), "{stdout}");
     for chart in ["rel_mse_vs_time", "mse_vs_time"] {
         assert!(std::fs::read_to_string(dir.join(format!("{chart}.svg"))).unwrap().contains("<svg"));

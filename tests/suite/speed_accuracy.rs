@@ -58,8 +58,8 @@ fn compare_equal_time_leaves_out_runs_over_budget() {
         lines,
         [
             "equal time 100.0 ms: restir:hybrid/gbh left out, its frames took 190.0 ms",
-            "equal time 100.0 ms: pt relMSE 4.0000e-1 (95.0 ms) / restir:reconnection/gbh relMSE 2.0000e-1 (110.0 ms) = 2.00x",
-            "equal time 100.0 ms, trimmed relMSE: pt 2.0000e-1 / restir:reconnection/gbh 1.0000e-1 = 2.00x",
+            "equal time 100.0 ms, relMSE: pt 4.0000e-1 (95.0 ms) / restir:reconnection/gbh 2.0000e-1 (110.0 ms) = 2.00x",
+            "equal time 100.0 ms, trimmed relMSE: pt 2.0000e-1 (95.0 ms) / restir:reconnection/gbh 1.0000e-1 (110.0 ms) = 2.00x",
         ]
     );
 }
