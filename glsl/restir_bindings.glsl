@@ -25,7 +25,7 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
     uint candidates;         // initial paths per pixel
     uint neighbours;         // spatial neighbours per round
     uint temporal_valid;     // 1 if the previous frame's reservoirs and surfaces exist
-    uint emission_rays;      // camera rays per pixel for the emission seen at the primary hit
+    uint emission_rays;      // camera rays per reservoir for the emission seen directly
     uint reservoirs;         // independent reservoirs per pixel (see reservoir_index)
     uint emission_history;   // 1 if `direct` holds the running mean of the same camera pose
 };

@@ -202,6 +202,7 @@ impl Restir {
         let frame_params = settings.frame_params(scene);
         self.params.write(std::slice::from_ref(&frame_params))?;
         let prev = self.history.map(|(_, p)| p).unwrap_or(frame_params);
+        let temporal_valid = self.restir.temporal && self.history.is_some();
         let reuse = ReuseParams {
             prev_cam_position: prev.cam_position,
             prev_cam_right: prev.cam_right,
@@ -216,12 +217,12 @@ impl Restir {
             frame_index: self.frame_index,
             candidates: self.restir.candidates,
             neighbours: self.restir.spatial,
-            temporal_valid: (self.restir.temporal && self.history.is_some()) as u32,
+            temporal_valid: temporal_valid as u32,
             emission_rays: self.restir.emission_rays,
             reservoirs: self.restir.reservoirs,
             // Frames being accumulated are averaged already; a running mean inside them would
             // only weigh the early frames' rays more.
-            emission_history: (self.restir.temporal && self.history.is_some() && same_pose(&prev, &frame_params) && !accumulate) as u32,
+            emission_history: (temporal_valid && same_pose(&prev, &frame_params) && !accumulate) as u32,
         };
         self.reuse.write(std::slice::from_ref(&reuse))?;
 
