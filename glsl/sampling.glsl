@@ -61,6 +61,9 @@ vec3 sample_ggx_vndf(vec3 wo, float alpha, vec2 u) {
 
 float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
+// The balance-heuristic weight of the technique of pdf a beside one of pdf b (0 where a is).
+float balance_heuristic(float a, float b) { return a > 0.0 ? a / (a + b) : 0.0; }
+
 float power_heuristic(float a, float b) {
     float a2 = a * a;
     float b2 = b * b;

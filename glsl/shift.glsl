@@ -121,8 +121,7 @@ float end_mis_weight(Vertex x, vec3 before, Vertex end, bool nee_end, bool after
     float bsdf_pdf;
     bsdf_eval_pdf(material_of(x), x.normal, normalize(before - x.pos), dir, bsdf_pdf);
     float light = light_pdf(x, end);
-    float own = nee_end ? light : bsdf_pdf;
-    return own > 0.0 ? own / (light + bsdf_pdf) : 0.0;
+    return nee_end ? balance_heuristic(light, bsdf_pdf) : balance_heuristic(bsdf_pdf, light);
 }
 
 Vertex hit_vertex(Hit hit) {

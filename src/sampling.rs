@@ -70,6 +70,16 @@ pub fn sample_ggx_vndf(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     Vec3::new(alpha * h_std.x, alpha * h_std.y, h_std.z.max(0.0)).normalize()
 }
 
+/// The balance-heuristic weight of the technique of pdf `a` beside one of pdf `b` (0 where `a`
+/// is).
+pub fn balance_heuristic(a: f32, b: f32) -> f32 {
+    if a > 0.0 {
+        a / (a + b)
+    } else {
+        0.0
+    }
+}
+
 pub fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 > 0.0 {

@@ -22,6 +22,7 @@ use crate::gpu_types::NO_EMITTER;
 use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
 use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
 use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
+use crate::sampling::balance_heuristic;
 use crate::scene::Scene;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
@@ -220,11 +221,10 @@ pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee
     let (dir, _) = direction(x, end);
     let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, (before - x.pos).normalize(), dir);
     let light = light_pdf(scene, x, end);
-    let own = if nee_end { light } else { bsdf_pdf };
-    if own > 0.0 {
-        own / (light + bsdf_pdf)
+    if nee_end {
+        balance_heuristic(light, bsdf_pdf)
     } else {
-        0.0
+        balance_heuristic(bsdf_pdf, light)
     }
 }
 

@@ -13,7 +13,8 @@ pub const RESERVOIR_SLOTS: usize = 3;
 pub struct ReservoirLayers {
     pub heads: [Buffer; RESERVOIR_SLOTS],
     pub tails: [Buffer; RESERVOIR_SLOTS],
-    /// The emission seen at each reservoir's primary hit.
+    /// Each reservoir's estimate of the emission seen directly (w: the frames in its running
+    /// mean under an unmoved camera).
     pub direct: Buffer,
     /// Each reservoir's expectation of f(Y) W_Y over its last resampling.
     pub expectation: Buffer,
