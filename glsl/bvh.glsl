@@ -116,14 +116,23 @@ vec3 offset_ray_origin(vec3 p, vec3 n) {
 // Segment tests stop this fraction short of their (offset) end point.
 const float SEGMENT_EPSILON = 1e-4;
 
-// Whether anything blocks the segment between surface points p (normal np) and q (normal nq).
-// Both ends are offset off their surfaces, each towards the other, and the ray runs between the
+// The shadow ray of the segment between surface points p (normal np) and q (normal nq). Both
+// ends are offset off their surfaces, each towards the other, and the ray runs between the
 // offset points: offsetting one end only moves a grazing far hit by more than any epsilon.
-bool segment_occluded(vec3 p, vec3 np, vec3 q, vec3 nq) {
+void segment_ray(vec3 p, vec3 np, vec3 q, vec3 nq, out vec3 origin, out vec3 dir, out float tmax) {
     vec3 d = q - p;
-    vec3 origin = offset_ray_origin(p, dot(d, np) > 0.0 ? np : -np);
+    origin = offset_ray_origin(p, dot(d, np) > 0.0 ? np : -np);
     vec3 target = offset_ray_origin(q, dot(d, nq) < 0.0 ? nq : -nq);
-    return trace_occluded(origin, target - origin, 1.0 - SEGMENT_EPSILON);
+    dir = target - origin;
+    tmax = 1.0 - SEGMENT_EPSILON;
+}
+
+// Whether anything blocks the segment between surface points p (normal np) and q (normal nq).
+bool segment_occluded(vec3 p, vec3 np, vec3 q, vec3 nq) {
+    vec3 origin, dir;
+    float tmax;
+    segment_ray(p, np, q, nq, origin, dir, tmax);
+    return trace_occluded(origin, dir, tmax);
 }
 
 #endif

@@ -1,8 +1,11 @@
 // The bindings every ReSTIR PT kernel shares (set 0, after the scene's 0-4), with loads and
 // stores by slot. Twins: ReuseParams, Surface, ReservoirHead/Tail, RestirStats and RestirPass
-// in src/gpu_types.rs. Slots are chosen by push constants, so that one descriptor set serves
-// every pass: reservoir slots 0-2 rotate between initial candidates, reuse rounds and the
-// previous frame's result; surface slots 0-1 alternate between frames.
+// in src/gpu_types.rs. Each pass reads its slots from the frame's pass table, picked by a push
+// constant, so that one descriptor set serves every pass: reservoir slots 0-2 rotate between
+// initial candidates, reuse rounds and the previous frame's result; surface slots 0-1 alternate
+// between frames. Parameters live in storage buffers and the push constant is only an index:
+// lavapipe compiles a kernel again for each new value of a uniform or push constant that steers
+// its control flow (src/vk/buffer.rs), and the slots steer every load and store below.
 #ifndef RESTIR_BINDINGS_GLSL
 #define RESTIR_BINDINGS_GLSL
 
@@ -10,7 +13,19 @@
 #include "reservoir.glsl"
 #include "loop_budget.glsl"
 
-layout(std140, set = 0, binding = 5) uniform ReuseParams {
+// Which slots a pass reads and writes, and its random-number key.
+struct RestirPass {
+    uint in_slot;
+    uint out_slot;
+    uint prev_slot;
+    uint surface_slot;   // the current frame's surfaces; the previous frame's are the other slot
+    uint pass_seed;      // distinguishes the random choices of passes and rounds
+};
+
+// The most passes a frame runs: initial, temporal, 3 spatial rounds and shading.
+const uint RESTIR_MAX_PASSES = 6u;
+
+layout(std430, set = 0, binding = 5) readonly buffer ReuseParams {
     vec4 prev_cam_position;  // the previous frame's camera, laid out like FrameParams' camera
     vec4 prev_cam_right;
     vec4 prev_cam_up;
@@ -28,6 +43,7 @@ layout(std140, set = 0, binding = 5) uniform ReuseParams {
     uint emission_rays;      // camera rays per reservoir for the emission seen directly
     uint reservoirs;         // independent reservoirs per pixel (see reservoir_index)
     uint emission_history;   // 1 if `direct` holds the running mean of the same camera pose
+    RestirPass passes[RESTIR_MAX_PASSES];
 };
 
 // A pixel's surface in one frame: the hit of the ray through its centre, from which temporal
@@ -65,13 +81,15 @@ layout(std430, set = 0, binding = 17) buffer RestirStats {
 // whichever pass last resampled the pixel.
 layout(std430, set = 0, binding = 18) buffer Expectation { vec4 expectation[]; };
 
-layout(push_constant) uniform RestirPass {
-    uint in_slot;
-    uint out_slot;
-    uint prev_slot;
-    uint surface_slot;   // the current frame's surfaces; the previous frame's are the other slot
-    uint pass_seed;      // distinguishes the random choices of passes and rounds
+layout(push_constant) uniform PassIndex {
+    uint pass_index;     // this dispatch's entry of `passes`
 };
+
+#define in_slot (passes[pass_index].in_slot)
+#define out_slot (passes[pass_index].out_slot)
+#define prev_slot (passes[pass_index].prev_slot)
+#define surface_slot (passes[pass_index].surface_slot)
+#define pass_seed (passes[pass_index].pass_seed)
 
 // A pixel keeps `reservoirs` independent reservoirs, each with its own paths, history and
 // neighbours, and the pixel's estimate is their mean. Each reservoir's path is one colour

@@ -107,79 +107,116 @@ ShiftResult shift_path(PathRecord base, Domain to) {
     return s;
 }
 
-// p̂_{<-l}(y) = p̂_l(T_l^{-1}(y)) |(T_l^{-1})'(y)| for y in the canonical domain; 0 where y
-// cannot be shifted into domain l. A non-finite value counts as a failed shift.
-float target_from(ReuseInput l, PathRecord y) {
-    if (same_domain(inputs[0].domain, l.domain)) return target_function(y.contribution);
-    ShiftResult s = shift_path(y, l.domain);
-    if (!s.valid) return 0.0;
-    float t = target_function(s.contribution) * s.jacobian;
-    if (!is_finite(t)) {
-        local_nonfinite_weights += 1u;
-        local_shifts_failed += 1u;
-        return 0.0;
-    }
-    return t;
-}
+// p̂_{<-l}(y) for the current resampling: [0] p̂(y) of the canonical domain, [i] input i's own
+// p̂ carried back by its Jacobian, [l] p̂_l(T_l^{-1}(y)) |(T_l^{-1})'(y)| (0 where y cannot be
+// shifted into domain l). A global for the reason `inputs` is one.
+float targets_from[MAX_INPUTS];
 
-// m_i(y) for input i's sample shifted to y (p̂(y) = p0, shift Jacobian `jacobian`).
-float mis_weight(uint n, uint i, PathRecord y, float p0, float jacobian) {
-    // For input i itself the inverse shift returns its own sample, whose p̂ it carries.
-    float own = i == 0u ? p0 : target_function(inputs[i].res.record.contribution) / jacobian;
+// m_i(y) for input i's sample shifted to y, from targets_from (twin: gris::mis_weight).
+float mis_weight(uint n, uint i) {
 #if MIS_MODE == MIS_GBH
-    float numerator = inputs[i].confidence * own;
+    float numerator = inputs[i].confidence * targets_from[i];
     float total = numerator;
-    if (i != 0u) total += inputs[0].confidence * p0;
+    if (i != 0u) total += inputs[0].confidence * targets_from[0];
     for (uint l = 1u; l < n; ++l) {
         loop_tick();
-        if (l != i) total += inputs[l].confidence * target_from(inputs[l], y);
+        if (l != i) total += inputs[l].confidence * targets_from[l];
     }
     return total > 0.0 ? numerator / total : 0.0;
 #else
     // Defensive pairwise MIS: the canonical input against each neighbour in turn.
     if (n == 1u) return 1.0;
     float k = float(n - 1u);
-    float canonical = inputs[0].confidence * p0 / k;
+    float canonical = inputs[0].confidence * targets_from[0] / k;
     if (i != 0u) {
-        float neighbour = inputs[i].confidence * own;
+        float neighbour = inputs[i].confidence * targets_from[i];
         return neighbour + canonical > 0.0 ? neighbour / (neighbour + canonical) / (k + 1.0) : 0.0;
     }
     float sum = 1.0;
     for (uint l = 1u; l < n; ++l) {
         loop_tick();
-        float neighbour = inputs[l].confidence * target_from(inputs[l], y);
+        float neighbour = inputs[l].confidence * targets_from[l];
         sum += neighbour + canonical > 0.0 ? canonical / (neighbour + canonical) : 1.0;
     }
     return sum / (k + 1.0);
 #endif
 }
 
+// Whether input i's MIS weight needs p̂_{<-l} of its shifted sample for l >= 1, l != i: every l
+// under the generalized balance heuristic, only the canonical input's under pairwise MIS.
+bool needs_targets_from(uint i) {
+#if MIS_MODE == MIS_GBH
+    return true;
+#else
+    return i == 0u;
+#endif
+}
+
 // Resamples inputs[0..n-1] (0: the canonical pixel's own reservoir) into one reservoir of the
 // canonical domain; `seed` keys the choice. `expected` receives E[f(Y) W_Y] over the choice.
+//
+// Step (i, l) of the n x n steps makes at most one shift: for l = 0 the shift of input i's
+// sample into the canonical domain, y_i = T_i(X_i); for l >= 1 (l != i) the inverse shift of y_i
+// into domain l, for p̂_{<-l}(y_i). Every shift goes through the one call below: a kernel
+// inlines each call site whole, and with a call per use the reuse kernels took llvmpipe 10 s
+// each to compile and overflowed its cache of compiled kernels, which then compiled them again
+// every frame.
 Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
     Resampler s = resampler_begin();
-    for (uint i = 0u; i < n; ++i) {
+    PathRecord y = inputs[0].res.record;
+    float jacobian = 1.0;
+    bool alive = false;
+    for (uint step = 0u; step < n * n; ++step) {
         loop_tick();
-        s.confidence += inputs[i].confidence;
-        // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
-        if (!(inputs[i].res.W > 0.0)) continue;
-        PathRecord y = inputs[i].res.record;
-        float jacobian = 1.0;
-        bool shifted_in = !same_domain(inputs[i].domain, inputs[0].domain);
-        if (shifted_in) {
-            ShiftResult shifted = shift_path(y, inputs[0].domain);
-            if (!shifted.valid) continue;
-            y = shifted.record;
-            jacobian = shifted.jacobian;
+        uint i = step / n;
+        uint l = step % n;
+        bool forward = l == 0u;
+        if (forward) {
+            s.confidence += inputs[i].confidence;
+            // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
+            alive = inputs[i].res.W > 0.0;
+            y = inputs[i].res.record;
+            jacobian = 1.0;
         }
-        float p0 = target_function(y.contribution);
-        float w = mis_weight(n, i, y, p0, jacobian) * p0 * inputs[i].res.W * jacobian;
-        if (!is_finite(w)) {
-            local_nonfinite_weights += 1u;
-            if (shifted_in) local_shifts_failed += 1u;
-            continue;
+        Domain from = forward ? inputs[i].domain : inputs[0].domain;
+        Domain to = forward ? inputs[0].domain : inputs[l].domain;
+        bool wanted = forward || (l != i && needs_targets_from(i));
+        bool shift = alive && wanted && !same_domain(from, to);
+        ShiftResult shifted = shift_failed();
+        if (shift) shifted = shift_path(y, to);
+        if (forward) {
+            if (shift && shifted.valid) {
+                y = shifted.record;
+                jacobian = shifted.jacobian;
+            }
+            alive = alive && (!shift || shifted.valid);
+            float p0 = target_function(y.contribution);
+            targets_from[0] = p0;
+            // For input i itself the inverse shift returns its own sample, whose p̂ it carries.
+            if (i != 0u) targets_from[i] = target_function(inputs[i].res.record.contribution) / jacobian;
+        } else if (alive && wanted) {
+            float t = target_function(y.contribution);
+            if (shift) {
+                t = shifted.valid ? target_function(shifted.contribution) * shifted.jacobian : 0.0;
+                // A non-finite value counts as a failed shift.
+                if (!is_finite(t)) {
+                    local_nonfinite_weights += 1u;
+                    local_shifts_failed += 1u;
+                    t = 0.0;
+                }
+            }
+            targets_from[l] = t;
         }
-        if (w > 0.0) resampler_add(s, y, p0, w, rng_uniform4(seed, i, STREAM_RESAMPLE).x);
+        if (l + 1u == n && alive) {
+            float p0 = targets_from[0];
+            float w = mis_weight(n, i) * p0 * inputs[i].res.W * jacobian;
+            if (!is_finite(w)) {
+                local_nonfinite_weights += 1u;
+                if (!same_domain(inputs[i].domain, inputs[0].domain)) local_shifts_failed += 1u;
+            } else if (w > 0.0) {
+                resampler_add(s, y, p0, w, rng_uniform4(seed, i, STREAM_RESAMPLE).x);
+            }
+        }
     }
     expected = s.expected;
     return resampler_finish(s);

@@ -5,7 +5,9 @@
 
 #include "types.glsl"
 
-layout(std140, set = 0, binding = 0) uniform FrameParams {
+// A read-only storage buffer, not a uniform buffer: lavapipe compiles a kernel again for every
+// new value of a uniform or push constant that steers its control flow (src/vk/buffer.rs).
+layout(std430, set = 0, binding = 0) readonly buffer FrameParams {
     vec4 cam_position;   // w: tan(yfov / 2)
     vec4 cam_right;      // w: aspect ratio (width / height)
     vec4 cam_up;

@@ -41,8 +41,12 @@ struct ShiftResult {
     PathRecord record;
     float jacobian;
     vec3 contribution;
-    uint vertex_count;                 // the vertices the shift made (see src/shift.rs)
+#ifdef SHIFT_ORACLE
+    // The vertices the shift made (see src/shift.rs), which only the oracle test compares:
+    // production kernels would copy them on every shift.
+    uint vertex_count;
     vec3 vertices[MAX_PATH_LENGTH];
+#endif
 };
 
 bool vertex_is_escaped(Vertex v) { return v.triangle == NO_HIT; }
@@ -90,10 +94,24 @@ void direction(Vertex from, Vertex to, out vec3 dir, out float dist) {
     }
 }
 
+// The shadow ray between two vertices: a segment between surface points, or a ray towards an
+// escaped vertex's direction. One ray for both cases keeps one traversal per call site: every
+// call inlines a whole traversal, and llvmpipe's compile time grows with the copies.
+void visibility_ray(Vertex from, Vertex to, out vec3 origin, out vec3 dir, out float tmax) {
+    if (!vertex_is_escaped(to)) {
+        segment_ray(from.pos, from.normal, to.pos, to.normal, origin, dir, tmax);
+    } else {
+        origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal);
+        dir = to.pos;
+        tmax = SHIFT_RAY_TMAX;
+    }
+}
+
 bool visible(Vertex from, Vertex to) {
-    if (!vertex_is_escaped(to)) return !segment_occluded(from.pos, from.normal, to.pos, to.normal);
-    vec3 origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal);
-    return !trace_occluded(origin, to.pos, SHIFT_RAY_TMAX);
+    vec3 origin, dir;
+    float tmax;
+    visibility_ray(from, to, origin, dir, tmax);
+    return !trace_occluded(origin, dir, tmax);
 }
 
 vec3 end_emission(Vertex from, Vertex end) {
@@ -138,14 +156,26 @@ bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex ligh
     return true;
 }
 
+// The BSDF sample at x_i drawn with the path's random numbers and the origin of its ray; false
+// if no lobe was sampled.
+bool bsdf_ray(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out vec3 origin) {
+    s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
+    if (s.lobe == LOBE_NONE) return false;
+    origin = offset_ray_origin(x.pos, dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal);
+    return true;
+}
+
+// The vertex a ray in direction `dir` reaches: its hit, or the environment.
+Vertex ray_end_vertex(Hit hit, vec3 dir) {
+    return hit.triangle == NO_HIT ? vertex_escaped(dir) : hit_vertex(hit);
+}
+
 // The vertex BSDF sampling at x_i reaches with the path's random numbers; false if no lobe was
 // sampled. Initial candidates and path regeneration share it, so that both build the same paths.
 bool bsdf_vertex(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out Vertex next) {
-    s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
-    if (s.lobe == LOBE_NONE) return false;
-    vec3 side = dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal;
-    Hit hit = trace_closest(offset_ray_origin(x.pos, side), s.wi, SHIFT_RAY_TMAX);
-    next = hit.triangle == NO_HIT ? vertex_escaped(s.wi) : hit_vertex(hit);
+    vec3 origin;
+    if (!bsdf_ray(x, wo, m, seed, i, s, origin)) return false;
+    next = ray_end_vertex(trace_closest(origin, s.wi, SHIFT_RAY_TMAX), s.wi);
     return true;
 }
 
@@ -160,7 +190,9 @@ void path_begin(vec3 camera, Vertex x1, uint seed, bool nee_end, out Path path) 
     path.end_weight = 0.0;
 }
 
-// The vertices, lobes and weights of a path regenerated from x1 with `seed`.
+// The vertices, lobes and weights of a path regenerated from x1 with `seed`. Each step traces
+// one ray, a shadow ray for the NEE step and a closest-hit ray otherwise, through a single
+// traversal (see visibility_ray).
 bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
     path_begin(camera, x1, seed, nee_end, path);
     vec3 prev_pos = camera;
@@ -171,21 +203,32 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
         if (vertex_is_escaped(x)) return false;
         vec3 wo = normalize(prev_pos - x.pos);
         Material m = material_of(x);
+        bool nee_step = i + 1u == target_length && nee_end;
         Vertex next;
         uint lobe;
         vec3 weight;
-        if (i + 1u == target_length && nee_end) {
+        vec3 origin, dir;
+        float tmax;
+        if (nee_step) {
             LightSample ls;
-            if (!nee_vertex(x, seed, i, ls, next) || !visible(x, next)) return false;
+            if (!nee_vertex(x, seed, i, ls, next)) return false;
             float bsdf_pdf;
-            vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
             lobe = LOBE_NONE;
-            weight = f_cos / ls.pdf;
+            weight = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf) / ls.pdf;
+            visibility_ray(x, next, origin, dir, tmax);
         } else {
             BsdfSample s;
-            if (!bsdf_vertex(x, wo, m, seed, i, s, next)) return false;
+            if (!bsdf_ray(x, wo, m, seed, i, s, origin)) return false;
             lobe = s.lobe;
             weight = s.weight;
+            dir = s.wi;
+            tmax = SHIFT_RAY_TMAX;
+        }
+        Hit hit = bvh_traverse(origin, dir, tmax, nee_step);
+        if (nee_step) {
+            if (hit.triangle != NO_HIT) return false;
+        } else {
+            next = ray_end_vertex(hit, dir);
         }
         path.lobes[i - 1u] = lobe;
         path.weights[i - 1u] = weight;
@@ -196,14 +239,15 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
     return true;
 }
 
-bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
-    if (!trace_vertices(camera, x1, seed, target_length, nee_end, path)) return false;
+// The end weight and contribution of a path whose vertices trace_vertices made; false if it
+// carries no light.
+bool finish_path(inout Path path) {
     uint k = path.count;
     vec3 c = vec3(0.0);
     if (k >= 2u) {
-        vec3 before = k >= 3u ? path.vertices[k - 3u].pos : camera;
+        vec3 before = k >= 3u ? path.vertices[k - 3u].pos : path.camera;
         bool after_delta = (path.lobes[k - 2u] & LOBE_DELTA) != 0u;
-        path.end_weight = end_mis_weight(path.vertices[k - 2u], before, path.vertices[k - 1u], nee_end, after_delta);
+        path.end_weight = end_mis_weight(path.vertices[k - 2u], before, path.vertices[k - 1u], path.nee_end, after_delta);
         c = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]) * path.end_weight;
     }
     for (uint i = 0u; i + 1u < k; ++i) {
@@ -212,6 +256,10 @@ bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool n
     }
     path.contribution = c;
     return max_component(c) > 0.0;
+}
+
+bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
+    return trace_vertices(camera, x1, seed, target_length, nee_end, path) && finish_path(path);
 }
 
 struct Link {
@@ -285,7 +333,9 @@ bool join_at_reconnection(PathRecord base, Vertex prev, vec3 before, Vertex x_r,
     return true;
 }
 
-bool record_path(Path path, ShiftParams params, out PathRecord record) {
+// The record of `path` without its reconnection's join (see record_path); returns the
+// reconnection index r (0: none), or MAX_PATH_LENGTH + 1 if the path is too long for a record.
+uint record_fields(Path path, ShiftParams params, out PathRecord record) {
     uint k = path.count;
     uint r = reconnection_index(path, params);
     record.seed = path.seed;
@@ -304,8 +354,8 @@ bool record_path(Path path, ShiftParams params, out PathRecord record) {
     record.rc_pdf_after = 1.0;
     record.contribution = path.contribution;
     record.rc_next_triangle = NO_HIT;
-    if (k > MAX_PATH_LENGTH) return false;
-    if (r == 0u) return true;
+    if (k > MAX_PATH_LENGTH) return MAX_PATH_LENGTH + 1u;
+    if (r == 0u) return 0u;
     Vertex x_r = path.vertices[r - 1u];
     record.rc_triangle = x_r.triangle;
     record.rc_pos = x_r.pos;
@@ -321,6 +371,14 @@ bool record_path(Path path, ShiftParams params, out PathRecord record) {
         }
         record.suffix = s;
     }
+    return r;
+}
+
+bool record_path(Path path, ShiftParams params, out PathRecord record) {
+    uint r = record_fields(path, params, record);
+    if (r > MAX_PATH_LENGTH) return false;
+    if (r == 0u) return true;
+    Vertex x_r = path.vertices[r - 1u];
     vec3 before = r >= 3u ? path.vertices[r - 3u].pos : path.camera;
     vec3 prefix_weight = vec3(1.0);
     for (uint i = 0u; i + 2u < r; ++i) {
@@ -340,7 +398,9 @@ ShiftResult shift_failed() {
     s.valid = false;
     s.jacobian = 0.0;
     s.contribution = vec3(0.0);
+#ifdef SHIFT_ORACLE
     s.vertex_count = 0u;
+#endif
     return s;
 }
 
@@ -353,29 +413,37 @@ ShiftResult shift_ok(PathRecord record, float jacobian, Path made) {
     s.record = record;
     s.jacobian = jacobian;
     s.contribution = record.contribution;
+#ifdef SHIFT_ORACLE
     s.vertex_count = made.count;
     for (uint i = 0u; i < made.count; ++i) {
         loop_tick();
         s.vertices[i] = made.vertices[i].pos;
     }
+#endif
     return s;
+}
+
+// Random replay on a regenerated path `y` (trace_vertices of the base's length and end type):
+// valid if it carries light and samples the base's lobes.
+ShiftResult finish_random_replay(ShiftParams params, PathRecord base, Path y) {
+    if (!finish_path(y)) return shift_failed();
+    PathRecord record;
+    if (!record_path(y, params, record) || record.lobes != base.lobes) return shift_failed();
+    return shift_ok(record, 1.0, y);
 }
 
 ShiftResult shift_random_replay(ShiftParams params, PathRecord base, vec3 camera, Vertex y1) {
     Path y;
-    if (!generate_path(camera, y1, base.seed, record_length(base), record_nee_end(base), y)) return shift_failed();
-    PathRecord record;
-    if (!record_path(y, params, record) || record.lobes != base.lobes) return shift_failed();
-    return shift_ok(record, 1.0, y);
+    if (!trace_vertices(camera, y1, base.seed, record_length(base), record_nee_end(base), y)) return shift_failed();
+    return finish_random_replay(params, base, y);
 }
 
 ShiftResult inverse_random_replay(ShiftParams params, PathRecord shifted, vec3 camera, Vertex x1) {
     return shift_random_replay(params, shifted, camera, x1);
 }
 
-ShiftResult reconnect_at(ShiftParams params, PathRecord base, vec3 camera, Vertex y1, uint r) {
-    Path prefix;
-    if (!trace_vertices(camera, y1, base.seed, r - 1u, false, prefix)) return shift_failed();
+// Reconnection of the regenerated prefix y_1..y_{r-1} (`prefix`) to the base's x_r.
+ShiftResult finish_reconnection(ShiftParams params, PathRecord base, Path prefix, uint r) {
     for (uint i = 1u; i + 1u < r; ++i) {
         loop_tick();
         if (prefix.lobes[i - 1u] != record_lobe(base, i)) return shift_failed();
@@ -387,7 +455,7 @@ ShiftResult reconnect_at(ShiftParams params, PathRecord base, vec3 camera, Verte
     Vertex y_prev = prefix.vertices[r - 2u];
     Vertex x_r = record_vertex(base.rc_triangle, base.rc_pos);
     if (!is_reconnectable(y_prev, x_r, params) || !visible(y_prev, x_r)) return shift_failed();
-    vec3 y_before = r >= 3u ? prefix.vertices[r - 3u].pos : camera;
+    vec3 y_before = r >= 3u ? prefix.vertices[r - 3u].pos : prefix.camera;
     vec3 prefix_weight = vec3(1.0);
     for (uint i = 0u; i + 1u < prefix.count; ++i) {
         loop_tick();
@@ -403,13 +471,27 @@ ShiftResult reconnect_at(ShiftParams params, PathRecord base, vec3 camera, Verte
     return shift_ok(joined, jacobian, prefix);
 }
 
+ShiftResult reconnect_at(ShiftParams params, PathRecord base, vec3 camera, Vertex y1, uint r) {
+    Path prefix;
+    if (!trace_vertices(camera, y1, base.seed, r - 1u, false, prefix)) return shift_failed();
+    return finish_reconnection(params, base, prefix, r);
+}
+
+// Random replay where the base has no reconnection vertex (and the replayed path must have none
+// either, or the shift would not be invertible), reconnection at the base's x_r otherwise. Both
+// branches share one regeneration of the path (random replay: the whole path; reconnection: the
+// prefix before x_r), so a kernel holds one copy of it; a replayed path needs no join.
 ShiftResult shift_hybrid(ShiftParams params, PathRecord base, vec3 camera, Vertex y1) {
     uint r = record_reconnection_index(base);
-    if (r == 0u) {
-        ShiftResult replay = shift_random_replay(params, base, camera, y1);
-        return replay.valid && record_reconnection_index(replay.record) == 0u ? replay : shift_failed();
-    }
-    return reconnect_at(params, base, camera, y1, r);
+    bool replay = r == 0u;
+    Path y;
+    uint length = replay ? record_length(base) : r - 1u;
+    if (!trace_vertices(camera, y1, base.seed, length, replay && record_nee_end(base), y)) return shift_failed();
+    if (!replay) return finish_reconnection(params, base, y, r);
+    if (!finish_path(y)) return shift_failed();
+    PathRecord record;
+    if (record_fields(y, params, record) != 0u || record.lobes != base.lobes) return shift_failed();
+    return shift_ok(record, 1.0, y);
 }
 
 ShiftResult inverse_hybrid(ShiftParams params, PathRecord shifted, vec3 camera, Vertex x1) {

@@ -81,7 +81,7 @@ impl Triangle {
 
 pub const FLAG_RUSSIAN_ROULETTE: u32 = 1;
 
-/// Binding 0 of every scene kernel (glsl/scene_bindings.glsl), std140 with only vec4-sized rows.
+/// Binding 0 of every scene kernel (glsl/scene_bindings.glsl), std430 with only vec4-sized rows.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct FrameParams {
@@ -100,7 +100,12 @@ pub struct FrameParams {
     pub emitter_count: u32,
 }
 
-/// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std140.
+/// The most passes a ReSTIR PT frame runs (RESTIR_MAX_PASSES in glsl/restir_bindings.glsl):
+/// initial, temporal, 3 spatial rounds and shading.
+pub const RESTIR_MAX_PASSES: usize = 6;
+
+/// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: the frame's reuse
+/// parameters and its pass table.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ReuseParams {
@@ -121,6 +126,8 @@ pub struct ReuseParams {
     pub emission_rays: u32,
     pub reservoirs: u32,
     pub emission_history: u32,
+    /// The frame's passes in dispatch order; a dispatch's push constant indexes them.
+    pub passes: [RestirPass; RESTIR_MAX_PASSES],
 }
 
 /// A pixel's primary hit in one frame (glsl/restir_bindings.glsl).
@@ -177,7 +184,8 @@ pub struct RestirStats {
     pub stats_pad: u32,
 }
 
-/// The push constants of the ReSTIR kernels: which slots a pass reads and writes.
+/// One entry of the ReSTIR kernels' pass table (ReuseParams::passes): which slots a pass reads
+/// and writes, and its random-number key.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct RestirPass {

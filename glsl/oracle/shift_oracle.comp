@@ -4,6 +4,7 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
+#define SHIFT_ORACLE 1
 #include "../scene_bindings.glsl"
 #include "../shift.glsl"
 

@@ -1,5 +1,6 @@
 //! Rendering on the GPU: scene upload, settings, the path tracer, ReSTIR PT and their images.
 
+mod frame_plan;
 mod image;
 mod path_tracer;
 mod reservoir_layers;
@@ -8,9 +9,10 @@ mod restir_settings;
 mod scene_gpu;
 mod settings;
 
+pub use frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PlannedPass, PASS_NAMES};
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
-pub use restir::{FrameStats, Restir, PASS_NAMES};
+pub use restir::{FrameStats, Restir};
 pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
 pub use scene_gpu::SceneGpu;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};

@@ -9,7 +9,7 @@ use anyhow::{Context as _, Result};
 use super::{Image, RenderSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::scene::Scene;
-use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
+use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
 /// Submissions are sized to about this much GPU time, which keeps GPU watchdogs far away.
 const TARGET_SUBMISSION_MS_GPU: f64 = 250.0;
@@ -63,17 +63,22 @@ impl PathTracer {
             ctx,
             "frame parameters",
             std::mem::size_of::<crate::gpu_types::FrameParams>() as u64,
-            BufferUsage::Uniform,
+            BufferUsage::Params,
         )?;
         let accum = Buffer::new(ctx, "accumulation", pixels * 16, BufferUsage::Storage)?;
         let accum_sq = Buffer::new(ctx, "accumulation of squares", pixels * 16, BufferUsage::Storage)?;
         let status = Buffer::new(ctx, "dispatch status", STATUS_WORDS * 4, BufferUsage::Storage)?;
         let mut bindings = scene_gpu.bindings();
         bindings.extend([Binding::Storage, Binding::Storage, Binding::Storage]);
-        let kernel = Kernel::new(ctx, "pathtrace.comp", &scene_gpu.defines(), &bindings, 0)?;
+        let mut kernel = Kernel::new(ctx, "pathtrace.comp", &scene_gpu.defines(), &bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
         buffers.extend([&accum, &accum_sq, &status]);
         kernel.bind(&buffers);
+        // One dispatch over zero pixels compiles the kernel now (llvmpipe compiles at the first
+        // dispatch), so that no sample's GPU time includes it.
+        let empty = crate::gpu_types::FrameParams::default();
+        params.write(std::slice::from_ref(&empty))?;
+        kernel.warm_up(&[]).context("compiling pathtrace.comp")?;
         accum.fill(0)?;
         accum_sq.fill(0)?;
         Ok(Self {
@@ -194,6 +199,11 @@ impl PathTracer {
             wall_ms: start.elapsed().as_secs_f64() * 1e3,
             interrupted,
         })
+    }
+
+    /// What building and compiling the kernel cost.
+    pub fn compile_report(&self) -> &KernelCompile {
+        self.kernel.compile_report()
     }
 
     pub fn image(&self) -> Result<Image> {

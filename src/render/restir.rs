@@ -1,24 +1,22 @@
 //! The ReSTIR PT renderer: per frame, initial candidates, temporal reuse, spatial rounds and
-//! shading (glsl/restir_*.comp) in one submission, with reservoirs in storage buffers.
+//! shading (glsl/restir_*.comp) in one submission, with reservoirs in storage buffers. Which
+//! passes run is planned in frame_plan.rs.
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 
-use super::reservoir_layers::{ReservoirLayers, RESERVOIR_SLOTS};
+use super::frame_plan::{pass_table, plan_frame, FramePlan, FrameState, PassKernel, PASS_NAMES};
+use super::reservoir_layers::ReservoirLayers;
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
-use crate::gpu_types::{FrameParams, RestirPass, RestirStats, ReuseParams, Surface};
+use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
 use crate::scene::Scene;
 use crate::shift::ShiftParams;
-use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, PassTimer};
+use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
 const LOCAL_SIZE: u32 = 8;
-
-/// The passes of a frame, in order; their GPU times are reported under these names.
-pub const PASS_NAMES: [&str; 4] = ["initial", "temporal", "spatial", "shade"];
-const SHADE_PASS: usize = 3;
 
 /// GPU milliseconds per pass of one frame (indexed like PASS_NAMES); None without timestamps.
 #[derive(Debug, Clone)]
@@ -46,12 +44,8 @@ impl FrameStats {
 
 pub struct Restir {
     ctx: Arc<Context>,
-    initial: Kernel,
-    temporal: Kernel,
-    /// Temporal reuse for frames whose camera did not move: nothing is shifted.
-    temporal_unmoved: Kernel,
-    spatial: Kernel,
-    shade: Kernel,
+    /// The frame's kernels, indexed by `PassKernel as usize`.
+    kernels: Vec<Kernel>,
     params: Buffer,
     reuse: Buffer,
     /// Each pixel's surface (glsl/restir_bindings.glsl), this frame's and the previous one's,
@@ -72,8 +66,33 @@ pub struct Restir {
     surface_slot: u32,
 }
 
+/// The GLSL file and extra `#define`s of each kernel.
+fn kernel_source(kernel: PassKernel) -> (&'static str, &'static [(&'static str, &'static str)]) {
+    match kernel {
+        PassKernel::Initial => ("restir_initial.comp", &[]),
+        PassKernel::Temporal => ("restir_temporal.comp", &[]),
+        PassKernel::TemporalUnmoved => ("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")]),
+        PassKernel::Spatial => ("restir_spatial.comp", &[]),
+        PassKernel::Shade => ("restir_shade.comp", &[]),
+    }
+}
+
 impl Restir {
+    /// Uploads `scene`, builds every kernel a run can use and compiles them (see `warm_up`);
+    /// the time that took is in `compile_reports`. `progress` hears each kernel's name before
+    /// it is built.
     pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, restir: &RestirSettings) -> Result<Self> {
+        Self::with_progress(ctx, scene, settings, restir, &|_| {})
+    }
+
+    /// `new`, telling `progress` the name of each kernel before it is compiled.
+    pub fn with_progress(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        settings: &RenderSettings,
+        restir: &RestirSettings,
+        progress: &dyn Fn(&str),
+    ) -> Result<Self> {
         settings.validate(scene)?;
         restir.validate(settings.max_depth)?;
         let pixels = settings.pixel_count() as u64;
@@ -83,50 +102,34 @@ impl Restir {
         let layers = ReservoirLayers::new(ctx, pixels, restir.reservoirs)?;
         let scene_gpu = SceneGpu::upload(ctx, scene)?;
         let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
-        let params = Buffer::new(
-            ctx,
-            "frame parameters",
-            std::mem::size_of::<FrameParams>() as u64,
-            BufferUsage::Uniform,
-        )?;
-        let reuse = Buffer::new(
-            ctx,
-            "reuse parameters",
-            std::mem::size_of::<ReuseParams>() as u64,
-            BufferUsage::Uniform,
-        )?;
+        let params_buffer = |name: &str, bytes: usize| Buffer::new(ctx, name, bytes as u64, BufferUsage::Params);
+        let params = params_buffer("frame parameters", std::mem::size_of::<FrameParams>())?;
+        let reuse = params_buffer("reuse parameters", std::mem::size_of::<ReuseParams>())?;
         let surfaces = [storage("surfaces 0", surface_bytes)?, storage("surfaces 1", surface_bytes)?];
         let accum = storage("accumulation", pixels * 16)?;
         let accum_sq = storage("accumulation of squares", pixels * 16)?;
         let stats = storage("ReSTIR statistics", std::mem::size_of::<RestirStats>() as u64)?;
 
         let mut bindings = scene_gpu.bindings();
-        bindings.push(Binding::Uniform);
-        bindings.extend([Binding::Storage; 13]);
+        bindings.extend([Binding::Storage; 14]);
         let mut defines = scene_gpu.defines();
         defines.extend(restir.defines());
-        let push = std::mem::size_of::<RestirPass>() as u32;
-        let kernel_with = |name: &str, extra: &[(&'static str, &'static str)]| -> Result<Kernel> {
+        let mut kernels = Vec::with_capacity(PassKernel::ALL.len());
+        for kernel in PassKernel::ALL {
+            let (file, extra) = kernel_source(kernel);
+            progress(file);
             let all: Vec<_> = defines.iter().chain(extra).copied().collect();
-            Kernel::new(ctx, name, &all, &bindings, push)
-        };
-        let kernel = |name: &str| kernel_with(name, &[]);
-        let (initial, temporal, temporal_unmoved, spatial, shade) = (
-            kernel("restir_initial.comp")?,
-            kernel("restir_temporal.comp")?,
-            kernel_with("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")])?,
-            kernel("restir_spatial.comp")?,
-            kernel("restir_shade.comp")?,
-        );
+            let mut k = Kernel::new(ctx, file, &all, &bindings, 4)?;
+            if kernel == PassKernel::TemporalUnmoved {
+                k.set_variant("(unmoved camera)");
+            }
+            kernels.push(k);
+        }
         accum.fill(0)?;
         accum_sq.fill(0)?;
-        let restir = Self {
+        let mut restir = Self {
             ctx: ctx.clone(),
-            initial,
-            temporal,
-            temporal_unmoved,
-            spatial,
-            shade,
+            kernels,
             params,
             reuse,
             surfaces,
@@ -144,7 +147,36 @@ impl Restir {
             surface_slot: 0,
         };
         restir.bind_buffers();
+        restir.warm_up(progress)?;
         Ok(restir)
+    }
+
+    /// Dispatches every kernel once over an image of zero pixels, which writes nothing: llvmpipe
+    /// compiles a kernel at its first dispatch, and that compile belongs to start-up, not to a
+    /// frame's GPU time.
+    fn warm_up(&mut self, progress: &dyn Fn(&str)) -> Result<()> {
+        let empty = FrameParams {
+            width: 0,
+            height: 0,
+            ..Default::default()
+        };
+        self.params.write(std::slice::from_ref(&empty))?;
+        self.reuse.write(std::slice::from_ref(&ReuseParams::default()))?;
+        for kernel in &mut self.kernels {
+            progress(&kernel.compile_report().name);
+            kernel.warm_up(&0u32.to_ne_bytes()).with_context(|| format!("compiling {}", kernel.name))?;
+        }
+        Ok(())
+    }
+
+    /// What building and compiling each kernel cost (one entry per kernel).
+    pub fn compile_reports(&self) -> Vec<KernelCompile> {
+        self.kernels.iter().map(|k| k.compile_report().clone()).collect()
+    }
+
+    /// Milliseconds of start-up spent compiling kernels, over all kernels.
+    pub fn compile_ms(&self) -> f64 {
+        self.kernels.iter().map(|k| k.compile_report().total_ms()).sum()
     }
 
     /// Points every kernel's descriptors at the current buffers.
@@ -157,7 +189,7 @@ impl Restir {
             buffers.extend([h, t]);
         }
         buffers.extend([&layers.direct, &self.accum, &self.accum_sq, &self.stats, &layers.expectation]);
-        for kernel in [&self.initial, &self.temporal, &self.temporal_unmoved, &self.spatial, &self.shade] {
+        for kernel in &self.kernels {
             kernel.bind(&buffers);
         }
     }
@@ -190,20 +222,10 @@ impl Restir {
         Ok(())
     }
 
-    /// Renders one frame from the scene's camera `camera`. With `accumulate` the frame is added
-    /// to the running average (a static camera's offline mode); otherwise the average restarts.
-    pub fn frame(&mut self, scene: &Scene, camera: usize, accumulate: bool) -> Result<FrameStats> {
-        let start = Instant::now();
-        let settings = RenderSettings {
-            camera,
-            ..self.settings.clone()
-        };
-        settings.validate(scene)?;
-        let frame_params = settings.frame_params(scene);
-        self.params.write(std::slice::from_ref(&frame_params))?;
-        let prev = self.history.map(|(_, p)| p).unwrap_or(frame_params);
+    /// The reuse parameters of a frame seen from `frame` after `prev`, with its pass table.
+    fn reuse_params(&self, prev: &FrameParams, frame: &FrameParams, plan: &FramePlan, accumulate: bool) -> ReuseParams {
         let temporal_valid = self.restir.temporal && self.history.is_some();
-        let reuse = ReuseParams {
+        ReuseParams {
             prev_cam_position: prev.cam_position,
             prev_cam_right: prev.cam_right,
             prev_cam_up: prev.cam_up,
@@ -222,79 +244,34 @@ impl Restir {
             reservoirs: self.restir.reservoirs,
             // Frames being accumulated are averaged already; a running mean inside them would
             // only weigh the early frames' rays more.
-            emission_history: (temporal_valid && same_pose(&prev, &frame_params) && !accumulate) as u32,
-        };
-        self.reuse.write(std::slice::from_ref(&reuse))?;
+            emission_history: (temporal_valid && same_pose(prev, frame) && !accumulate) as u32,
+            passes: pass_table(plan),
+        }
+    }
 
-        // The previous frame's result stays in its slot for temporal reuse; the other two
-        // slots take turns as pass inputs and outputs.
-        let prev_slot = self.history.map(|(s, _)| s).unwrap_or(RESERVOIR_SLOTS as u32 - 1);
-        let work: Vec<u32> = (0..RESERVOIR_SLOTS as u32).filter(|&s| s != prev_slot).collect();
-        let surface_slot = self.surface_slot;
-        let pass = |in_slot: u32, out_slot: u32, pass_seed: u32| RestirPass {
-            in_slot,
-            out_slot,
-            prev_slot,
-            surface_slot,
-            pass_seed,
+    /// Renders one frame from the scene's camera `camera`. With `accumulate` the frame is added
+    /// to the running average (a static camera's offline mode); otherwise the average restarts.
+    pub fn frame(&mut self, scene: &Scene, camera: usize, accumulate: bool) -> Result<FrameStats> {
+        let start = Instant::now();
+        let settings = RenderSettings {
+            camera,
+            ..self.settings.clone()
         };
-        let mut passes: Vec<(&Kernel, usize, RestirPass)> = vec![(&self.initial, 0, pass(0, work[0], 0))];
-        let mut current = 0;
-        if reuse.temporal_valid != 0 {
-            let temporal = if same_pose(&prev, &frame_params) {
-                &self.temporal_unmoved
-            } else {
-                &self.temporal
-            };
-            passes.push((temporal, 1, pass(work[current], work[1 - current], 0x7e3a_11c5)));
-            current = 1 - current;
-        }
-        for round in 0..self.restir.spatial_rounds() {
-            passes.push((&self.spatial, 2, pass(work[current], work[1 - current], 0x5bd1_e995 ^ (round + 1))));
-            current = 1 - current;
-        }
-        passes.push((&self.shade, SHADE_PASS, pass(work[current], work[current], 0)));
-        // Every pass but shading runs once per reservoir (the z dimension); shading averages a
-        // pixel's reservoirs.
-        let groups = |slot: usize| {
-            [
-                self.settings.width.div_ceil(LOCAL_SIZE),
-                self.settings.height.div_ceil(LOCAL_SIZE),
-                if slot == SHADE_PASS { 1 } else { self.restir.reservoirs },
-            ]
-        };
+        settings.validate(scene)?;
+        let frame_params = settings.frame_params(scene);
+        let prev = self.history.map(|(_, p)| p).unwrap_or(frame_params);
+        let plan = plan_frame(&FrameState {
+            history_slot: self.history.map(|(s, _)| s),
+            temporal: self.restir.temporal,
+            unmoved: same_pose(&prev, &frame_params),
+            surface_slot: self.surface_slot,
+            spatial_rounds: self.restir.spatial_rounds(),
+        });
+        self.params.write(std::slice::from_ref(&frame_params))?;
+        let reuse = self.reuse_params(&prev, &frame_params, &plan, accumulate);
+        self.reuse.write(std::slice::from_ref(&reuse))?;
         self.ctx
-            .submit_and_wait(|cmd| {
-                self.stats.record_fill(cmd, 0);
-                if !accumulate {
-                    self.accum.record_fill(cmd, 0);
-                    self.accum_sq.record_fill(cmd, 0);
-                }
-                record_compute_barrier(&self.ctx.device, cmd);
-                self.timer.record_reset(cmd);
-                let mut open: Option<usize> = None;
-                for (kernel, slot, push) in &passes {
-                    if open != Some(*slot) {
-                        if let Some(s) = open {
-                            self.timer.record_end(cmd, s as u32);
-                        }
-                        self.timer.record_begin(cmd, *slot as u32);
-                        open = Some(*slot);
-                    }
-                    kernel.record_dispatch(cmd, groups(*slot), bytemuck::bytes_of(push));
-                    record_compute_barrier(&self.ctx.device, cmd);
-                }
-                if let Some(s) = open {
-                    self.timer.record_end(cmd, s as u32);
-                }
-                // Passes that did not run this frame get an empty interval.
-                for slot in 0..PASS_NAMES.len() {
-                    if !passes.iter().any(|p| p.1 == slot) {
-                        self.timer.record_begin(cmd, slot as u32);
-                        self.timer.record_end(cmd, slot as u32);
-                    }
-                }
-            })
+            .submit_and_wait(|cmd| self.record_frame(cmd, &plan, accumulate))
             .context("ReSTIR PT frame")?;
         let counters = self.stats.read::<RestirStats>(1)?[0];
         if counters.loop_budget_cut_groups > 0 {
@@ -306,7 +283,7 @@ impl Restir {
             .into());
         }
         let pass_ms = self.timer.read_ms(PASS_NAMES.len() as u32)?.map(|t| [t[0], t[1], t[2], t[3]]);
-        self.history = Some((work[current], frame_params));
+        self.history = Some((plan.final_slot, frame_params));
         self.surface_slot = 1 - self.surface_slot;
         self.frame_index += 1;
         Ok(FrameStats {
@@ -314,6 +291,48 @@ impl Restir {
             wall_ms: start.elapsed().as_secs_f64() * 1e3,
             counters,
         })
+    }
+
+    /// Records a frame's dispatches; each pass's push constant is its index in the pass table.
+    /// Every pass but shading runs once per reservoir (the z dimension); shading averages a
+    /// pixel's reservoirs.
+    fn record_frame(&self, cmd: ash::vk::CommandBuffer, plan: &FramePlan, accumulate: bool) {
+        self.stats.record_fill(cmd, 0);
+        if !accumulate {
+            self.accum.record_fill(cmd, 0);
+            self.accum_sq.record_fill(cmd, 0);
+        }
+        record_compute_barrier(&self.ctx.device, cmd);
+        self.timer.record_reset(cmd);
+        let mut open: Option<usize> = None;
+        for (index, pass) in plan.passes.iter().enumerate() {
+            let slot = pass.kernel.timer_slot();
+            if open != Some(slot) {
+                if let Some(s) = open {
+                    self.timer.record_end(cmd, s as u32);
+                }
+                self.timer.record_begin(cmd, slot as u32);
+                open = Some(slot);
+            }
+            let layers = if pass.kernel == PassKernel::Shade { 1 } else { self.restir.reservoirs };
+            let groups = [
+                self.settings.width.div_ceil(LOCAL_SIZE),
+                self.settings.height.div_ceil(LOCAL_SIZE),
+                layers,
+            ];
+            self.kernels[pass.kernel as usize].record_dispatch(cmd, groups, &(index as u32).to_ne_bytes());
+            record_compute_barrier(&self.ctx.device, cmd);
+        }
+        if let Some(s) = open {
+            self.timer.record_end(cmd, s as u32);
+        }
+        // Passes that did not run this frame get an empty interval.
+        for slot in 0..PASS_NAMES.len() {
+            if !plan.passes.iter().any(|p| p.kernel.timer_slot() == slot) {
+                self.timer.record_begin(cmd, slot as u32);
+                self.timer.record_end(cmd, slot as u32);
+            }
+        }
     }
 
     /// The average of the frames accumulated since the last restart.

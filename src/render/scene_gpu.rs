@@ -52,7 +52,7 @@ impl SceneGpu {
     /// The descriptor kinds of bindings 0-4.
     pub fn bindings(&self) -> Vec<Binding> {
         let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
-        vec![Binding::Uniform, scene, scene, scene, scene]
+        vec![Binding::Storage, scene, scene, scene, scene]
     }
 
     /// The `#define`s every scene kernel is compiled with.

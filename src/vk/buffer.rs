@@ -14,8 +14,12 @@ pub enum BufferUsage {
     /// Read or written by kernels; lives in device memory, reached by staging copies. Also
     /// bindable as a uniform buffer, which small read-only scene arrays use on CPU devices.
     Storage,
-    /// Small inputs rewritten from the host between dispatches; host-visible.
-    Uniform,
+    /// Small parameter blocks rewritten from the host between frames; host-visible, bound as
+    /// read-only storage buffers. Not uniform buffers: lavapipe inlines uniform-buffer and
+    /// push-constant values that steer a kernel's control flow and compiles the kernel again
+    /// whenever those values change (Mesa's lvp_execute.c, update_inline_shader_state), which
+    /// made reuse passes recompile for seconds mid-run.
+    Params,
     /// Staging memory the host maps for uploads and readbacks.
     Staging,
 }
@@ -42,7 +46,7 @@ impl Buffer {
                     | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             ),
-            BufferUsage::Uniform => (vk::BufferUsageFlags::UNIFORM_BUFFER, MemoryLocation::CpuToGpu),
+            BufferUsage::Params => (vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu),
             BufferUsage::Staging => (
                 vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,

@@ -1,6 +1,8 @@
 //! A compute pipeline with one descriptor set of buffers and an optional push-constant block.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use ash::vk;
@@ -23,8 +25,40 @@ impl Binding {
     }
 }
 
+/// Compute pipelines created by this process, counted so that tests can show a run creates none
+/// after its start-up.
+static PIPELINES_CREATED: AtomicU64 = AtomicU64::new(0);
+
+/// The number of compute pipelines this process has created so far.
+pub fn pipelines_created() -> u64 {
+    PIPELINES_CREATED.load(Ordering::Relaxed)
+}
+
+/// What building one kernel cost, in wall-clock milliseconds per stage. Drivers may compile at
+/// pipeline creation or at the first dispatch (llvmpipe JIT-compiles there), so both count.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct KernelCompile {
+    /// The GLSL file and its variant, e.g. "restir_temporal.comp (unmoved)".
+    pub name: String,
+    /// Size of the SPIR-V module in bytes.
+    pub spirv_bytes: usize,
+    /// GLSL to SPIR-V (shaderc; 0 when the process had compiled the same source before).
+    pub glsl_ms: f64,
+    /// vkCreateComputePipelines.
+    pub pipeline_ms: f64,
+    /// The first dispatch of one workgroup (see `Kernel::warm_up`), 0 before it.
+    pub first_dispatch_ms: f64,
+}
+
+impl KernelCompile {
+    pub fn total_ms(&self) -> f64 {
+        self.glsl_ms + self.pipeline_ms + self.first_dispatch_ms
+    }
+}
+
 pub struct Kernel {
     pub name: String,
+    compile: KernelCompile,
     bindings: Vec<Binding>,
     push_bytes: u32,
     pipeline: vk::Pipeline,
@@ -39,8 +73,41 @@ pub struct Kernel {
 impl Kernel {
     /// Builds the kernel glsl/`name` whose set 0 has `bindings` at indices 0..n.
     pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], bindings: &[Binding], push_bytes: u32) -> Result<Self> {
+        let start = Instant::now();
         let spirv = compile_kernel(name, defines)?;
-        Self::from_spirv(ctx, name, &spirv, bindings, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))
+        let glsl_ms = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        let mut kernel = Self::from_spirv(ctx, name, &spirv, bindings, push_bytes)
+            .with_context(|| format!("creating the compute pipeline {name}"))?;
+        kernel.compile = KernelCompile {
+            name: name.to_string(),
+            spirv_bytes: spirv.len() * 4,
+            glsl_ms,
+            pipeline_ms: start.elapsed().as_secs_f64() * 1e3,
+            first_dispatch_ms: 0.0,
+        };
+        Ok(kernel)
+    }
+
+    /// What building this kernel cost so far.
+    pub fn compile_report(&self) -> &KernelCompile {
+        &self.compile
+    }
+
+    /// Names the kernel's variant in its compile report, e.g. "(unmoved)".
+    pub fn set_variant(&mut self, variant: &str) {
+        self.compile.name = format!("{} {variant}", self.name);
+    }
+
+    /// Dispatches one workgroup with `push` and waits, so that a driver that compiles at the
+    /// first dispatch (llvmpipe) does so now rather than inside a timed frame; the time goes to
+    /// `compile_report().first_dispatch_ms`. The caller makes the dispatch harmless, e.g. with
+    /// an image size of zero in the bound parameters.
+    pub fn warm_up(&mut self, push: &[u8]) -> Result<(), GpuError> {
+        let start = Instant::now();
+        self.run_1d(1, 1, push)?;
+        self.compile.first_dispatch_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(())
     }
 
     fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], bindings: &[Binding], push_bytes: u32) -> Result<Self, GpuError> {
@@ -48,6 +115,7 @@ impl Kernel {
         // Each handle is owned by `kernel` as soon as it exists, so an early return frees it.
         let mut kernel = Kernel {
             name: name.to_string(),
+            compile: KernelCompile::default(),
             bindings: bindings.to_vec(),
             push_bytes,
             pipeline: vk::Pipeline::null(),
@@ -90,6 +158,7 @@ impl Kernel {
         let pipeline_info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(kernel.layout)];
         kernel.pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &pipeline_info, None) }
             .map_err(|(_, e)| vk_error("creating a compute pipeline")(e))?[0];
+        PIPELINES_CREATED.fetch_add(1, Ordering::Relaxed);
 
         let mut sizes = Vec::new();
         for kind in [Binding::Uniform, Binding::Storage] {

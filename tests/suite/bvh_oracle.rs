@@ -83,7 +83,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         &ctx,
         "params",
         std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
-        BufferUsage::Uniform,
+        BufferUsage::Params,
     )
     .unwrap();
     params.write(&[settings.frame_params(&scene)]).unwrap();

@@ -48,17 +48,7 @@ pub fn run_oracle<T: bytemuck::Pod>(
     let mut bindings: Vec<&Buffer> = leading.to_vec();
     bindings.extend(input_buffers.iter());
     bindings.push(&output);
-    let kinds: Vec<Binding> = bindings
-        .iter()
-        .enumerate()
-        .map(|(i, _)| {
-            if i == 0 && !leading.is_empty() {
-                Binding::Uniform
-            } else {
-                Binding::Storage
-            }
-        })
-        .collect();
+    let kinds = vec![Binding::Storage; bindings.len()];
     let k = Kernel::new(ctx, kernel, &[], &kinds, 4).unwrap();
     k.bind(&bindings);
     k.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();

@@ -137,7 +137,7 @@ fn restir_structs_match_glsl_layout() {
     let structs = vec![
         rust_fields!(ReuseParams: prev_cam_position, prev_cam_right, prev_cam_up, prev_cam_forward, roughness_threshold,
             distance_threshold, m_cap, radius, normal_threshold, depth_threshold, frame_index, candidates, neighbours,
-            temporal_valid, emission_rays, reservoirs, emission_history),
+            temporal_valid, emission_rays, reservoirs, emission_history, passes),
         rust_fields!(Surface: pos, triangle, camera, depth),
         rust_fields!(ReservoirHead: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry),
         rust_fields!(ReservoirTail: suffix, rc_pdf_after, contribution, rc_next_triangle, weight, confidence, pad0, pad1),

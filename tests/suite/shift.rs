@@ -369,7 +369,7 @@ fn check_glsl_matches_rust(kind: Kind) {
             &ctx,
             "params",
             std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
-            BufferUsage::Uniform,
+            BufferUsage::Params,
         )
         .unwrap();
         frame.write(&[RenderSettings::default().frame_params(&scene)]).unwrap();

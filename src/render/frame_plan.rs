@@ -1,0 +1,211 @@
+//! Which passes a ReSTIR PT frame runs, with which kernel and which reservoir slots: a pure
+//! function of the frame's state, so that it is tested without a device.
+
+use super::reservoir_layers::RESERVOIR_SLOTS;
+use crate::gpu_types::{RestirPass, RESTIR_MAX_PASSES};
+
+/// The kernels of a frame (glsl/restir_*.comp).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PassKernel {
+    Initial,
+    /// Temporal reuse with shifts, for a moved camera.
+    Temporal,
+    /// Temporal reuse of an unmoved camera, compiled without shift code.
+    TemporalUnmoved,
+    Spatial,
+    Shade,
+}
+
+impl PassKernel {
+    /// Every kernel, in the order a frame runs them.
+    pub const ALL: [PassKernel; 5] = [
+        PassKernel::Initial,
+        PassKernel::Temporal,
+        PassKernel::TemporalUnmoved,
+        PassKernel::Spatial,
+        PassKernel::Shade,
+    ];
+
+    /// The timer slot of the pass (an index into `PASS_NAMES`).
+    pub fn timer_slot(self) -> usize {
+        match self {
+            PassKernel::Initial => 0,
+            PassKernel::Temporal | PassKernel::TemporalUnmoved => 1,
+            PassKernel::Spatial => 2,
+            PassKernel::Shade => 3,
+        }
+    }
+}
+
+/// The passes of a frame, the names its GPU times are reported under.
+pub const PASS_NAMES: [&str; 4] = ["initial", "temporal", "spatial", "shade"];
+
+/// What a frame starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FrameState {
+    /// The slot holding the previous frame's final reservoirs, if there was a previous frame.
+    pub history_slot: Option<u32>,
+    /// Temporal reuse is on.
+    pub temporal: bool,
+    /// The camera has not moved since the previous frame.
+    pub unmoved: bool,
+    /// The current frame's surface slot (0 or 1).
+    pub surface_slot: u32,
+    /// Spatial reuse rounds (0 to 3).
+    pub spatial_rounds: u32,
+}
+
+/// One dispatch of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlannedPass {
+    pub kernel: PassKernel,
+    pub slots: RestirPass,
+}
+
+/// A frame's dispatches, and the slot its final reservoirs end in (the next frame's history).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FramePlan {
+    pub passes: Vec<PlannedPass>,
+    pub final_slot: u32,
+}
+
+const TEMPORAL_SEED: u32 = 0x7e3a_11c5;
+const SPATIAL_SEED: u32 = 0x5bd1_e995;
+
+/// Plans a frame: initial candidates into a free slot, temporal reuse when a history exists,
+/// the spatial rounds, then shading of the last result. The history's slot is never written.
+pub fn plan_frame(state: &FrameState) -> FramePlan {
+    // The previous frame's result keeps its slot; the passes alternate between the other two.
+    let prev_slot = state.history_slot.unwrap_or(RESERVOIR_SLOTS as u32 - 1);
+    let work: Vec<u32> = (0..RESERVOIR_SLOTS as u32).filter(|&s| s != prev_slot).collect();
+    let slots = |in_slot: u32, out_slot: u32, pass_seed: u32| RestirPass {
+        in_slot,
+        out_slot,
+        prev_slot,
+        surface_slot: state.surface_slot,
+        pass_seed,
+    };
+    let mut passes = vec![PlannedPass {
+        kernel: PassKernel::Initial,
+        slots: slots(0, work[0], 0),
+    }];
+    let mut current = 0;
+    if state.temporal && state.history_slot.is_some() {
+        let kernel = if state.unmoved {
+            PassKernel::TemporalUnmoved
+        } else {
+            PassKernel::Temporal
+        };
+        passes.push(PlannedPass {
+            kernel,
+            slots: slots(work[current], work[1 - current], TEMPORAL_SEED),
+        });
+        current = 1 - current;
+    }
+    for round in 0..state.spatial_rounds {
+        passes.push(PlannedPass {
+            kernel: PassKernel::Spatial,
+            slots: slots(work[current], work[1 - current], SPATIAL_SEED ^ (round + 1)),
+        });
+        current = 1 - current;
+    }
+    passes.push(PlannedPass {
+        kernel: PassKernel::Shade,
+        slots: slots(work[current], work[current], 0),
+    });
+    debug_assert!(passes.len() <= RESTIR_MAX_PASSES);
+    FramePlan {
+        passes,
+        final_slot: work[current],
+    }
+}
+
+/// The pass table of ReuseParams: the plan's slots in dispatch order, unused entries zero.
+pub fn pass_table(plan: &FramePlan) -> [RestirPass; RESTIR_MAX_PASSES] {
+    let mut table = [RestirPass::default(); RESTIR_MAX_PASSES];
+    for (entry, pass) in table.iter_mut().zip(&plan.passes) {
+        *entry = pass.slots;
+    }
+    table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(history_slot: Option<u32>, unmoved: bool, spatial_rounds: u32) -> FrameState {
+        FrameState {
+            history_slot,
+            temporal: true,
+            unmoved,
+            surface_slot: 1,
+            spatial_rounds,
+        }
+    }
+
+    #[test]
+    fn first_frame_has_no_temporal_pass_and_keeps_slot_2_free() {
+        let plan = plan_frame(&state(None, false, 1));
+        let kernels: Vec<_> = plan.passes.iter().map(|p| p.kernel).collect();
+        assert_eq!(kernels, [PassKernel::Initial, PassKernel::Spatial, PassKernel::Shade]);
+        assert_eq!(plan.passes[0].slots.out_slot, 0);
+        assert_eq!(plan.passes[1].slots.in_slot, 0);
+        assert_eq!(plan.passes[1].slots.out_slot, 1);
+        assert_eq!(plan.final_slot, 1);
+        assert!(plan.passes.iter().all(|p| p.slots.surface_slot == 1));
+    }
+
+    #[test]
+    fn history_slot_is_read_never_written() {
+        for history in 0..RESERVOIR_SLOTS as u32 {
+            for rounds in 0..=3 {
+                for unmoved in [false, true] {
+                    let plan = plan_frame(&state(Some(history), unmoved, rounds));
+                    assert!(plan.passes.iter().all(|p| p.slots.out_slot != history && p.slots.prev_slot == history));
+                    assert_ne!(plan.final_slot, history);
+                    assert_eq!(plan.passes.len(), 3 + rounds as usize);
+                    assert!(plan.passes.len() <= RESTIR_MAX_PASSES);
+                    let temporal = if unmoved {
+                        PassKernel::TemporalUnmoved
+                    } else {
+                        PassKernel::Temporal
+                    };
+                    assert_eq!(plan.passes[1].kernel, temporal);
+                    // Each reuse pass reads what the pass before it wrote.
+                    for pair in plan.passes.windows(2) {
+                        assert_eq!(pair[1].slots.in_slot, pair[0].slots.out_slot);
+                    }
+                    let shade = plan.passes.last().expect("a plan ends with shading");
+                    assert_eq!(shade.kernel, PassKernel::Shade);
+                    assert_eq!(shade.slots.in_slot, plan.final_slot);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn temporal_reuse_off_keeps_the_history_slot_unwritten_and_skips_the_pass() {
+        let plan = plan_frame(&FrameState {
+            temporal: false,
+            ..state(Some(1), false, 1)
+        });
+        let kernels: Vec<_> = plan.passes.iter().map(|p| p.kernel).collect();
+        assert_eq!(kernels, [PassKernel::Initial, PassKernel::Spatial, PassKernel::Shade]);
+        assert!(plan.passes.iter().all(|p| p.slots.out_slot != 1));
+    }
+
+    #[test]
+    fn spatial_rounds_draw_distinct_random_numbers() {
+        let plan = plan_frame(&state(Some(0), false, 3));
+        let seeds: Vec<u32> = plan.passes.iter().map(|p| p.slots.pass_seed).collect();
+        let mut unique = seeds[1..4].to_vec();
+        unique.sort_unstable();
+        unique.dedup();
+        assert_eq!(unique.len(), 3, "temporal and spatial rounds: {seeds:?}");
+        let table = pass_table(&plan);
+        assert_eq!(plan.passes.len(), RESTIR_MAX_PASSES);
+        assert_eq!(&table[..], &plan.passes.iter().map(|p| p.slots).collect::<Vec<_>>()[..]);
+        let short = plan_frame(&state(None, false, 0));
+        assert_eq!(pass_table(&short)[short.passes.len()..], [RestirPass::default(); RESTIR_MAX_PASSES - 2]);
+    }
+}
