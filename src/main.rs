@@ -23,8 +23,9 @@ enum Command {
     /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG with ReSTIR PT (default)
     /// or the path tracer.
     Render(RenderCmd),
-    /// Print a scene's triangles, emitters, materials, bounds and cameras.
-    Info { scene: PathBuf },
+    /// Print a scene's triangles, emitters, materials, bounds and cameras; with --kernels, the
+    /// SPIR-V size and compile time of each kernel the scene would use.
+    Info(InfoCmd),
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
     Bench(BenchCmd),
     /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
@@ -72,6 +73,19 @@ enum MisOpt {
     Gbh,
     /// Defensive pairwise MIS (O(M) shifts).
     Pairwise,
+}
+
+#[derive(Args)]
+struct InfoCmd {
+    scene: PathBuf,
+    /// Also build every kernel of the path tracer and of ReSTIR PT (with the shift and MIS
+    /// given) and print its SPIR-V size and compile time per stage.
+    #[arg(long)]
+    kernels: bool,
+    #[command(flatten)]
+    restir: RestirOpts,
+    #[command(flatten)]
+    device: DeviceOpts,
 }
 
 #[derive(Args)]
@@ -171,8 +185,9 @@ struct RenderCmd {
     /// Index of the glTF camera to render from (scene order); with --frames, the first pose.
     #[arg(long, default_value_t = 0)]
     camera: usize,
-    /// Render F frames along the scene's camera path: frame k uses camera (--camera + k).
-    /// The last frame goes to --out; every frame too with --out-dir.
+    /// Render F frames along the scene's camera path from --camera: its cameras in order, then
+    /// back and forth (0, 1, ..., n-1, n-2, ..., 0, 1, ...). The last frame goes to --out;
+    /// every frame too with --out-dir.
     #[arg(long, default_value_t = 1)]
     frames: u32,
     /// Render every frame from --camera and write the average of the frames (offline mode).
@@ -373,7 +388,10 @@ fn main() -> ExitCode {
             report: r.report,
             device: r.device.into(),
         }),
-        Command::Info { scene } => cli::info(&scene),
+        Command::Info(i) => {
+            let kernels = i.kernels.then(|| (i.restir.settings(), i.device.into()));
+            cli::info(&i.scene, kernels)
+        }
         Command::Reference(r) => cli::reference(cli::ReferenceArgs {
             scene: r.scene,
             spp: r.spp,

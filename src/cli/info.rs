@@ -5,10 +5,51 @@ use std::path::Path;
 use anyhow::Result;
 use glam::Vec3;
 
-use super::load_with_warnings;
+use super::{finish_device, load_with_warnings, open_device, DeviceArgs};
+use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings};
+use crate::vk::KernelCompile;
 
-pub fn info(path: &Path) -> Result<()> {
+/// Prints what `path` contains; with `kernels`, also builds the scene's kernels (the path
+/// tracer's and ReSTIR PT's with the given settings) on the device and prints their costs.
+pub fn info(path: &Path, kernels: Option<(RestirSettings, DeviceArgs)>) -> Result<()> {
     let scene = load_with_warnings(path)?;
+    print_scene(path, &scene);
+    if let Some((restir, device)) = kernels {
+        let ctx = open_device(&device)?;
+        let settings = RenderSettings {
+            width: 8,
+            height: 8,
+            max_depth: crate::path_record::MAX_PATH_LENGTH as u32,
+            ..Default::default()
+        };
+        let mut reports = vec![PathTracer::new(&ctx, &scene, &settings)?.compile_report().clone()];
+        reports.extend(Restir::new(&ctx, &scene, &settings, &restir)?.compile_reports());
+        print_kernels(&restir.label(), &reports);
+        finish_device(&ctx)?;
+    }
+    Ok(())
+}
+
+/// One line per kernel: SPIR-V bytes and milliseconds of GLSL compile, pipeline creation and
+/// first dispatch (where llvmpipe compiles).
+fn print_kernels(label: &str, reports: &[KernelCompile]) {
+    println!("kernels ({label}; compile stages in ms: GLSL, pipeline, first dispatch):");
+    for k in reports {
+        println!(
+            "  {:<40} {:>8} B SPIR-V | {:>7.0} {:>7.0} {:>7.0} | total {:>7.0} ms",
+            k.name,
+            k.spirv_bytes,
+            k.glsl_ms,
+            k.pipeline_ms,
+            k.first_dispatch_ms,
+            k.total_ms()
+        );
+    }
+    let total: f64 = reports.iter().map(|k| k.total_ms()).sum();
+    println!("  all kernels: {total:.0} ms");
+}
+
+fn print_scene(path: &Path, scene: &crate::scene::Scene) {
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());
@@ -49,5 +90,4 @@ pub fn info(path: &Path) -> Result<()> {
             c.yfov.to_degrees()
         );
     }
-    Ok(())
 }

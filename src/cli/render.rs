@@ -11,7 +11,7 @@ use serde::Serialize;
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::image_io::{write_exr, write_png};
 use crate::render::{FrameStats, PathTracer, RenderSettings, Restir, RestirSettings, PASS_NAMES};
-use crate::scene::Scene;
+use crate::scene::{camera_on_path, Scene};
 
 /// The rendering method: the path tracer, or ReSTIR PT with its settings.
 #[derive(Debug, Clone)]
@@ -54,8 +54,24 @@ pub struct RenderReport {
     pub gpu_ms: f64,
     pub wall_ms: f64,
     pub paths_per_second: f64,
+    /// Start-up milliseconds spent compiling the kernels (outside every frame's time).
+    pub compile_ms: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub restir: Option<RestirFrameReport>,
+}
+
+/// A spinner that names the kernel being compiled; compiling takes seconds on llvmpipe.
+pub(super) fn compile_progress() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(indicatif::ProgressStyle::with_template("{spinner} compiling {msg}  {elapsed}").expect("static template is valid"));
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
+/// The start-up line: how long compiling the kernels took.
+pub(super) fn print_compile_summary(kernels: &[crate::vk::KernelCompile]) {
+    let total: f64 = kernels.iter().map(|k| k.total_ms()).sum();
+    eprintln!("start-up: {} kernel(s) compiled in {total:.0} ms", kernels.len());
 }
 
 impl RenderReport {
@@ -105,13 +121,13 @@ pub(super) fn create_parent(file: &Path) -> Result<()> {
     }
 }
 
-/// The scene camera of frame `frame`: --camera for a static camera, else the next camera of the
-/// scene's camera path for each frame.
-fn frame_camera(args: &RenderArgs, frame: u32) -> usize {
+/// The scene camera of frame `frame`: --camera for a static camera, else the scene's camera
+/// path from --camera (`camera_on_path`).
+fn frame_camera(args: &RenderArgs, frame: u32, cameras: usize) -> usize {
     if args.static_camera {
         args.camera
     } else {
-        args.camera + frame as usize
+        camera_on_path(args.camera, frame, cameras)
     }
 }
 
@@ -121,14 +137,10 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let last_camera = frame_camera(&args, args.frames - 1);
-    if last_camera >= scene.cameras.len() {
-        bail!(
-            "{}: --frames {} from --camera {} needs camera {last_camera}, but the scene has {} camera(s) (--static-camera renders every frame from one)",
-            path.display(),
-            args.frames,
-            args.camera,
-            scene.cameras.len()
+    if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
+        eprintln!(
+            "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",
+            path.display()
         );
     }
     if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
@@ -226,10 +238,15 @@ fn render_path_traced(
     outputs: &Outputs,
 ) -> Result<Option<RenderReport>> {
     let interrupt = interrupt_flag();
+    let spinner = compile_progress();
+    spinner.set_message("pathtrace.comp");
     let mut tracer = PathTracer::new(ctx, scene, settings)?;
+    spinner.finish_and_clear();
+    let compile = tracer.compile_report().clone();
+    print_compile_summary(std::slice::from_ref(&compile));
     for frame in 0..args.frames {
         if frame > 0 {
-            let camera = frame_camera(args, frame);
+            let camera = frame_camera(args, frame, scene.cameras.len());
             tracer.restart(
                 scene,
                 &RenderSettings {
@@ -254,6 +271,7 @@ fn render_path_traced(
             gpu_ms: stats.gpu_ms,
             wall_ms: stats.wall_ms,
             paths_per_second: stats.paths_per_second(settings.pixel_count()),
+            compile_ms: compile.total_ms(),
             restir: None,
         };
         println!("{}{}", frame_prefix(args, frame), frame_report.summary_line());
@@ -323,11 +341,15 @@ fn render_restir(
     outputs: &Outputs,
 ) -> Result<Option<RenderReport>> {
     let interrupt = interrupt_flag();
-    let mut renderer = Restir::new(ctx, scene, settings, restir)?;
+    let spinner = compile_progress();
+    let mut renderer = Restir::with_progress(ctx, scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
+    spinner.finish_and_clear();
+    let compile_reports = renderer.compile_reports();
+    print_compile_summary(&compile_reports);
     let mut gpu_ms = 0.0;
     let mut report = None;
     for frame in 0..args.frames {
-        let stats = renderer.frame(scene, frame_camera(args, frame), args.static_camera)?;
+        let stats = renderer.frame(scene, frame_camera(args, frame, scene.cameras.len()), args.static_camera)?;
         let image = renderer.image()?;
         outputs.write_frame(frame, &image)?;
         let frame_ms = stats.gpu_ms().unwrap_or(stats.wall_ms);
@@ -344,6 +366,7 @@ fn render_restir(
             gpu_ms: frame_ms,
             wall_ms: stats.wall_ms,
             paths_per_second: settings.pixel_count() as f64 * (restir.candidates * restir.reservoirs) as f64 / (frame_ms * 1e-3),
+            compile_ms: compile_reports.iter().map(|k| k.total_ms()).sum(),
             restir: Some(detail.clone()),
         };
         println!(

@@ -16,7 +16,7 @@ use super::{bundled_file, finish_device, load_with_warnings, open_device, Device
 use crate::charts::{write_line_chart, LineChart, Series};
 use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
 use crate::render::{PathTracer, RenderSettings, RestirSettings};
-use crate::scene::Scene;
+use crate::scene::{camera_on_path, Scene};
 
 pub struct StabilityArgs {
     pub scenes: Vec<PathBuf>,
@@ -53,15 +53,9 @@ impl CameraMotion {
 
     /// The scene camera of frame `frame` among `cameras` poses.
     fn camera(self, frame: u32, cameras: usize) -> usize {
-        if self == CameraMotion::Static || cameras < 2 {
-            return 0;
-        }
-        let period = 2 * (cameras - 1);
-        let k = frame as usize % period;
-        if k < cameras {
-            k
-        } else {
-            period - k
+        match self {
+            CameraMotion::Static => 0,
+            CameraMotion::Moving => camera_on_path(0, frame, cameras),
         }
     }
 }

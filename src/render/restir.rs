@@ -79,13 +79,12 @@ fn kernel_source(kernel: PassKernel) -> (&'static str, &'static [(&'static str, 
 
 impl Restir {
     /// Uploads `scene`, builds every kernel a run can use and compiles them (see `warm_up`);
-    /// the time that took is in `compile_reports`. `progress` hears each kernel's name before
-    /// it is built.
+    /// the time that took is in `compile_reports`.
     pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, restir: &RestirSettings) -> Result<Self> {
         Self::with_progress(ctx, scene, settings, restir, &|_| {})
     }
 
-    /// `new`, telling `progress` the name of each kernel before it is compiled.
+    /// `new`, telling `progress` the name of each kernel before the driver compiles it.
     pub fn with_progress(
         ctx: &Arc<Context>,
         scene: &Scene,
@@ -117,7 +116,6 @@ impl Restir {
         let mut kernels = Vec::with_capacity(PassKernel::ALL.len());
         for kernel in PassKernel::ALL {
             let (file, extra) = kernel_source(kernel);
-            progress(file);
             let all: Vec<_> = defines.iter().chain(extra).copied().collect();
             let mut k = Kernel::new(ctx, file, &all, &bindings, 4)?;
             if kernel == PassKernel::TemporalUnmoved {

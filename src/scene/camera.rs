@@ -65,3 +65,36 @@ impl Camera {
         (self.forward + x * self.right + y * self.up).normalize()
     }
 }
+
+/// The camera of frame `frame` of a moving camera that starts at camera `start` and walks the
+/// scene's `cameras` poses in order, back at the last and forward again at the first
+/// (0, 1, ..., n-1, n-2, ..., 1, 0, 1, ...), so that any number of frames follows the path and
+/// every frame after the first has moved. A scene with one camera stays on it.
+pub fn camera_on_path(start: usize, frame: u32, cameras: usize) -> usize {
+    if cameras < 2 {
+        return 0;
+    }
+    let period = 2 * (cameras - 1);
+    let k = (start + frame as usize) % period;
+    if k < cameras {
+        k
+    } else {
+        period - k
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::camera_on_path;
+
+    #[test]
+    fn camera_path_goes_back_and_forth_and_moves_every_frame() {
+        let path: Vec<usize> = (0..16).map(|f| camera_on_path(0, f, 8)).collect();
+        assert_eq!(path, [0, 1, 2, 3, 4, 5, 6, 7, 6, 5, 4, 3, 2, 1, 0, 1]);
+        assert!(path.windows(2).all(|w| w[0] != w[1]));
+        assert_eq!(camera_on_path(6, 2, 8), 6);
+        assert_eq!(camera_on_path(3, 0, 8), 3);
+        assert_eq!((0..5).map(|f| camera_on_path(0, f, 1)).collect::<Vec<_>>(), [0; 5]);
+        assert_eq!((0..4).map(|f| camera_on_path(1, f, 2)).collect::<Vec<_>>(), [1, 0, 1, 0]);
+    }
+}

@@ -3,7 +3,7 @@
 mod camera;
 mod gltf_loader;
 
-pub use camera::Camera;
+pub use camera::{camera_on_path, Camera};
 pub use gltf_loader::{load_scene, load_scene_from_bytes};
 
 use glam::Vec3;
