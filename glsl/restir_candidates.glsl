@@ -45,9 +45,9 @@ void record_chosen(inout Resampler s, Path p, TracedCandidate c, ShiftParams par
     p.count = c.count;
     p.nee_end = c.nee_end;
     if (c.nee_end) {
-        p.vertices[c.count - 1u] = c.light;
-        p.lobes[c.count - 2u] = LOBE_NONE;
-        p.weights[c.count - 2u] = c.nee_weight;
+        set_path_vertex(c.count - 1u, c.light);
+        set_path_lobe(c.count - 2u, LOBE_NONE);
+        set_path_weight(c.count - 2u, c.nee_weight);
     }
     p.end_weight = c.end_weight;
     p.contribution = c.contribution;
@@ -72,7 +72,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
     bool chose = false;
     for (uint i = 1u; i < max_length; ++i) {
         loop_tick();
-        Vertex x = p.vertices[i - 1u];
+        Vertex x = path_vertex(i - 1u);
         if (vertex_is_escaped(x)) break;
         vec3 wo = normalize(prev_pos - x.pos);
         Material m = material_of(x);
@@ -99,9 +99,9 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         BsdfSample b;
         Vertex next;
         if (!bsdf_vertex(x, wo, m, seed, i, b, next)) break;
-        p.lobes[i - 1u] = b.lobe;
-        p.weights[i - 1u] = b.weight;
-        p.vertices[i] = next;
+        set_path_lobe(i - 1u, b.lobe);
+        set_path_weight(i - 1u, b.weight);
+        set_path_vertex(i, next);
         p.count = i + 1u;
         prefix *= b.weight;
         vec3 emitted = end_emission(x, next);

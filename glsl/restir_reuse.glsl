@@ -35,9 +35,13 @@ struct Domain {
     bool previous;   // seen from the previous frame's camera
 };
 
-// One input of a resampling: a reservoir of `domain`, and its confidence weight c.
+// One input of a resampling: the reservoir at `index` of reservoir slot `slot`, of `domain`, and
+// its confidence weight c. The reservoir stays in its buffer until it is resampled: lavapipe
+// turns a run-time index into a local array into selects over every element, so an array of
+// whole reservoirs cost more compile and run time than the loads.
 struct ReuseInput {
-    Reservoir res;
+    uint slot;
+    uint index;
     Domain domain;
     float confidence;
 };
@@ -45,6 +49,10 @@ struct ReuseInput {
 // The inputs of the current resampling, 0 the canonical one. A global rather than a parameter:
 // glslang's optimiser mistypes arrays of these structs passed by value.
 ReuseInput inputs[MAX_INPUTS];
+
+Reservoir input_reservoir(uint i) {
+    return load_reservoir(inputs[i].slot, inputs[i].index);
+}
 
 CameraPose previous_camera() {
     return CameraPose(prev_cam_position, prev_cam_right, prev_cam_up, prev_cam_forward);
@@ -163,7 +171,8 @@ bool needs_targets_from(uint i) {
 // every frame.
 Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
     Resampler s = resampler_begin();
-    PathRecord y = inputs[0].res.record;
+    PathRecord y = reservoir_empty().record;
+    float W = 0.0;
     float jacobian = 1.0;
     bool alive = false;
     for (uint step = 0u; step < n * n; ++step) {
@@ -174,8 +183,10 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         if (forward) {
             s.confidence += inputs[i].confidence;
             // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
-            alive = inputs[i].res.W > 0.0;
-            y = inputs[i].res.record;
+            Reservoir res = input_reservoir(i);
+            W = res.W;
+            alive = W > 0.0;
+            y = res.record;
             jacobian = 1.0;
         }
         Domain from = forward ? inputs[i].domain : inputs[0].domain;
@@ -193,7 +204,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
             float p0 = target_function(y.contribution);
             targets_from[0] = p0;
             // For input i itself the inverse shift returns its own sample, whose p̂ it carries.
-            if (i != 0u) targets_from[i] = target_function(inputs[i].res.record.contribution) / jacobian;
+            if (i != 0u) targets_from[i] = target_function(input_reservoir(i).record.contribution) / jacobian;
         } else if (alive && wanted) {
             float t = target_function(y.contribution);
             if (shift) {
@@ -209,7 +220,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         }
         if (l + 1u == n && alive) {
             float p0 = targets_from[0];
-            float w = mis_weight(n, i) * p0 * inputs[i].res.W * jacobian;
+            float w = mis_weight(n, i) * p0 * W * jacobian;
             if (!is_finite(w)) {
                 local_nonfinite_weights += 1u;
                 if (!same_domain(inputs[i].domain, inputs[0].domain)) local_shifts_failed += 1u;

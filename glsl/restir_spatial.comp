@@ -20,7 +20,7 @@ void main() {
         Surface surface = load_surface(surface_slot, pixel);
         if (surface.triangle != NO_HIT) {
             uint seed = path_seed(index, frame_index, render_seed ^ pass_seed);
-            inputs[0] = ReuseInput(canonical, Domain(p, false), canonical.M);
+            inputs[0] = ReuseInput(in_slot, index, Domain(p, false), canonical.M);
             uint n = 1u;
             for (uint j = 0u; j < min(neighbours, MAX_INPUTS - 1u); ++j) {
                 loop_tick();
@@ -31,8 +31,8 @@ void main() {
                 if (q.x < 0 || q.y < 0 || q.x >= int(width) || q.y >= int(height) || all(equal(uvec2(q), p))) continue;
                 uint neighbour = uint(q.y) * width + uint(q.x);
                 if (!similar_surfaces(surface, load_surface(surface_slot, neighbour))) continue;
-                Reservoir res = load_reservoir(in_slot, reservoir_index(neighbour, layer));
-                inputs[n] = ReuseInput(res, Domain(uvec2(q), false), res.M);
+                uint neighbour_index = reservoir_index(neighbour, layer);
+                inputs[n] = ReuseInput(in_slot, neighbour_index, Domain(uvec2(q), false), load_reservoir(in_slot, neighbour_index).M);
                 n += 1u;
             }
             vec3 expected;

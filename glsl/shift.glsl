@@ -24,17 +24,31 @@ struct Vertex {
     uint triangle;
 };
 
+// A path x1..xk. Its vertices, lobes and weights are not members but the invocation's rows of
+// the shared arrays below, so an invocation builds one path at a time: lavapipe turns every
+// run-time index into a function-local array into a chain of selects over the whole array,
+// and with the per-vertex arrays in Path the shift kernels took seconds longer to compile.
 struct Path {
     uint seed;
     vec3 camera;
     uint count;                        // the number of vertices k
     bool nee_end;
-    Vertex vertices[MAX_PATH_LENGTH];  // x1..xk
-    uint lobes[MAX_PATH_LENGTH];       // the lobe sampled at x_i is lobes[i - 1]
-    vec3 weights[MAX_PATH_LENGTH];     // f_s |cos| / p at x_i is weights[i - 1]
     vec3 contribution;
     float end_weight;                  // end_mis_weight of the technique that made x_k
 };
+
+const uint PATH_INVOCATIONS = gl_WorkGroupSize.x * gl_WorkGroupSize.y * gl_WorkGroupSize.z;
+shared Vertex path_vertices[PATH_INVOCATIONS * MAX_PATH_LENGTH];  // x1..xk
+shared uint path_lobes[PATH_INVOCATIONS * MAX_PATH_LENGTH];       // the lobe sampled at x_i is [i - 1]
+shared vec3 path_weights[PATH_INVOCATIONS * MAX_PATH_LENGTH];     // f_s |cos| / p at x_i is [i - 1]
+
+uint path_row(uint i) { return gl_LocalInvocationIndex * MAX_PATH_LENGTH + i; }
+Vertex path_vertex(uint i) { return path_vertices[path_row(i)]; }
+uint path_lobe(uint i) { return path_lobes[path_row(i)]; }
+vec3 path_weight(uint i) { return path_weights[path_row(i)]; }
+void set_path_vertex(uint i, Vertex v) { path_vertices[path_row(i)] = v; }
+void set_path_lobe(uint i, uint lobe) { path_lobes[path_row(i)] = lobe; }
+void set_path_weight(uint i, vec3 w) { path_weights[path_row(i)] = w; }
 
 struct ShiftResult {
     bool valid;
@@ -78,7 +92,7 @@ bool is_reconnectable(Vertex prev, Vertex cur, ShiftParams params) {
 uint reconnection_index(Path path, ShiftParams params) {
     for (uint r = 2u; r <= path.count; ++r) {
         loop_tick();
-        if (is_reconnectable(path.vertices[r - 2u], path.vertices[r - 1u], params)) return r;
+        if (is_reconnectable(path_vertex(r - 2u), path_vertex(r - 1u), params)) return r;
     }
     return 0u;
 }
@@ -185,7 +199,7 @@ void path_begin(vec3 camera, Vertex x1, uint seed, bool nee_end, out Path path) 
     path.camera = camera;
     path.count = 1u;
     path.nee_end = nee_end;
-    path.vertices[0] = x1;
+    set_path_vertex(0, x1);
     path.contribution = vec3(0.0);
     path.end_weight = 0.0;
 }
@@ -199,7 +213,7 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
     while (path.count < target_length) {
         loop_tick();
         uint i = path.count;
-        Vertex x = path.vertices[i - 1u];
+        Vertex x = path_vertex(i - 1u);
         if (vertex_is_escaped(x)) return false;
         vec3 wo = normalize(prev_pos - x.pos);
         Material m = material_of(x);
@@ -230,9 +244,9 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
         } else {
             next = ray_end_vertex(hit, dir);
         }
-        path.lobes[i - 1u] = lobe;
-        path.weights[i - 1u] = weight;
-        path.vertices[i] = next;
+        set_path_lobe(i - 1u, lobe);
+        set_path_weight(i - 1u, weight);
+        set_path_vertex(i, next);
         path.count += 1u;
         prev_pos = x.pos;
     }
@@ -245,14 +259,14 @@ bool finish_path(inout Path path) {
     uint k = path.count;
     vec3 c = vec3(0.0);
     if (k >= 2u) {
-        vec3 before = k >= 3u ? path.vertices[k - 3u].pos : path.camera;
-        bool after_delta = (path.lobes[k - 2u] & LOBE_DELTA) != 0u;
-        path.end_weight = end_mis_weight(path.vertices[k - 2u], before, path.vertices[k - 1u], path.nee_end, after_delta);
-        c = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]) * path.end_weight;
+        vec3 before = k >= 3u ? path_vertex(k - 3u).pos : path.camera;
+        bool after_delta = (path_lobe(k - 2u) & LOBE_DELTA) != 0u;
+        path.end_weight = end_mis_weight(path_vertex(k - 2u), before, path_vertex(k - 1u), path.nee_end, after_delta);
+        c = end_emission(path_vertex(k - 2u), path_vertex(k - 1u)) * path.end_weight;
     }
     for (uint i = 0u; i + 1u < k; ++i) {
         loop_tick();
-        c *= path.weights[i];
+        c *= path_weight(i);
     }
     path.contribution = c;
     return max_component(c) > 0.0;
@@ -307,11 +321,19 @@ bool join_at_reconnection(PathRecord base, Vertex prev, vec3 before, Vertex x_r,
     record.rc_pdf = link.pdf;
     record.rc_geometry = link.geometry;
     record.rc_pdf_after = 1.0;
-    vec3 weight = prefix_weight * link.f_cos / link.pdf;
-    vec3 contribution;
+    vec3 contribution = prefix_weight * link.f_cos / link.pdf;
+    // The end's MIS weight is evaluated anew where the join changes it: at x_r when x_r ends the
+    // path, at the next vertex when x_r is the last scattering vertex (its incoming direction
+    // changed); otherwise the suffix holds it. One call for both keeps one copy of the BSDF
+    // evaluation in the kernel.
+    Vertex mis_from = prev;
+    vec3 mis_before = before;
+    Vertex mis_end = x_r;
+    bool mis_after_delta = false;
+    bool needs_mis = true;
     if (r == k) {
-        bool after_delta = (record_lobe(base, k - 1u) & LOBE_DELTA) != 0u;
-        contribution = weight * end_emission(prev, x_r) * end_mis_weight(prev, before, x_r, record_nee_end(base), after_delta);
+        mis_after_delta = (record_lobe(base, k - 1u) & LOBE_DELTA) != 0u;
+        contribution *= end_emission(prev, x_r);
     } else {
         Vertex x_next = record_vertex(base.rc_next_triangle, base.rc_next);
         bool next_is_nee = r + 1u == k && record_nee_end(base);
@@ -323,11 +345,13 @@ bool join_at_reconnection(PathRecord base, Vertex prev, vec3 before, Vertex x_r,
             has_pdf_after = true;
             pdf_after_x_r = q;
         }
-        contribution = weight * f_r / q * base.suffix;
-        // The suffix holds the end's MIS weight unless x_r is the last scattering vertex, whose
-        // incoming direction the join changes.
-        if (r + 1u == k) contribution *= end_mis_weight(x_r, prev.pos, x_next, record_nee_end(base), false);
+        contribution = contribution * f_r / q * base.suffix;
+        needs_mis = r + 1u == k;
+        mis_from = x_r;
+        mis_before = prev.pos;
+        mis_end = x_next;
     }
+    if (needs_mis) contribution *= end_mis_weight(mis_from, mis_before, mis_end, record_nee_end(base), mis_after_delta);
     if (!(max_component(contribution) > 0.0)) return false;
     record.contribution = contribution;
     return true;
@@ -343,7 +367,7 @@ uint record_fields(Path path, ShiftParams params, out PathRecord record) {
     record.lobes = 0u;
     for (uint i = 0u; i + 1u < k; ++i) {
         loop_tick();
-        record.lobes |= path.lobes[i] << (LOBE_BITS * i);
+        record.lobes |= path_lobe(i) << (LOBE_BITS * i);
     }
     record.rc_triangle = NO_HIT;
     record.rc_pos = vec3(0.0);
@@ -356,18 +380,18 @@ uint record_fields(Path path, ShiftParams params, out PathRecord record) {
     record.rc_next_triangle = NO_HIT;
     if (k > MAX_PATH_LENGTH) return MAX_PATH_LENGTH + 1u;
     if (r == 0u) return 0u;
-    Vertex x_r = path.vertices[r - 1u];
+    Vertex x_r = path_vertex(r - 1u);
     record.rc_triangle = x_r.triangle;
     record.rc_pos = x_r.pos;
     if (r < k) {
-        Vertex x_next = path.vertices[r];
+        Vertex x_next = path_vertex(r);
         record.rc_next = x_next.pos;
         record.rc_next_triangle = x_next.triangle;
-        vec3 s = end_emission(path.vertices[k - 2u], path.vertices[k - 1u]);
+        vec3 s = end_emission(path_vertex(k - 2u), path_vertex(k - 1u));
         if (r + 1u < k) s *= path.end_weight;
         for (uint i = r; i + 1u < k; ++i) {
             loop_tick();
-            s *= path.weights[i];
+            s *= path_weight(i);
         }
         record.suffix = s;
     }
@@ -378,17 +402,17 @@ bool record_path(Path path, ShiftParams params, out PathRecord record) {
     uint r = record_fields(path, params, record);
     if (r > MAX_PATH_LENGTH) return false;
     if (r == 0u) return true;
-    Vertex x_r = path.vertices[r - 1u];
-    vec3 before = r >= 3u ? path.vertices[r - 3u].pos : path.camera;
+    Vertex x_r = path_vertex(r - 1u);
+    vec3 before = r >= 3u ? path_vertex(r - 3u).pos : path.camera;
     vec3 prefix_weight = vec3(1.0);
     for (uint i = 0u; i + 2u < r; ++i) {
         loop_tick();
-        prefix_weight *= path.weights[i];
+        prefix_weight *= path_weight(i);
     }
     PathRecord joined;
     bool has_after;
     float after;
-    if (!join_at_reconnection(record, path.vertices[r - 2u], before, x_r, prefix_weight, joined, has_after, after)) return false;
+    if (!join_at_reconnection(record, path_vertex(r - 2u), before, x_r, prefix_weight, joined, has_after, after)) return false;
     record = joined;
     return true;
 }
@@ -417,7 +441,7 @@ ShiftResult shift_ok(PathRecord record, float jacobian, Path made) {
     s.vertex_count = made.count;
     for (uint i = 0u; i < made.count; ++i) {
         loop_tick();
-        s.vertices[i] = made.vertices[i].pos;
+        s.vertices[i] = path_vertex(i).pos;
     }
 #endif
     return s;
@@ -446,20 +470,20 @@ ShiftResult inverse_random_replay(ShiftParams params, PathRecord shifted, vec3 c
 ShiftResult finish_reconnection(ShiftParams params, PathRecord base, Path prefix, uint r) {
     for (uint i = 1u; i + 1u < r; ++i) {
         loop_tick();
-        if (prefix.lobes[i - 1u] != record_lobe(base, i)) return shift_failed();
+        if (path_lobe(i - 1u) != record_lobe(base, i)) return shift_failed();
     }
     for (uint i = 2u; i < r; ++i) {
         loop_tick();
-        if (is_reconnectable(prefix.vertices[i - 2u], prefix.vertices[i - 1u], params)) return shift_failed();
+        if (is_reconnectable(path_vertex(i - 2u), path_vertex(i - 1u), params)) return shift_failed();
     }
-    Vertex y_prev = prefix.vertices[r - 2u];
+    Vertex y_prev = path_vertex(r - 2u);
     Vertex x_r = record_vertex(base.rc_triangle, base.rc_pos);
     if (!is_reconnectable(y_prev, x_r, params) || !visible(y_prev, x_r)) return shift_failed();
-    vec3 y_before = r >= 3u ? prefix.vertices[r - 3u].pos : prefix.camera;
+    vec3 y_before = r >= 3u ? path_vertex(r - 3u).pos : prefix.camera;
     vec3 prefix_weight = vec3(1.0);
     for (uint i = 0u; i + 1u < prefix.count; ++i) {
         loop_tick();
-        prefix_weight *= prefix.weights[i];
+        prefix_weight *= path_weight(i);
     }
     PathRecord joined;
     bool has_after;
