@@ -295,9 +295,14 @@ struct CompareCmd {
     /// spends a budget on path-tracer spp or ReSTIR PT reservoirs per pixel (each with --candidates paths).
     #[arg(long, value_delimiter = ',')]
     budgets_ms: Vec<f64>,
-    /// Frames of a static camera per run; the error is measured on the last frame alone.
+    /// Frames per run; the error is measured on the last frame alone.
     #[arg(long, default_value_t = 16)]
     frames: u32,
+    /// Move the camera along the scene's camera path from --camera (as `render --frames` does)
+    /// instead of keeping it still; --reference must then be of the last frame's camera, which
+    /// the command prints.
+    #[arg(long)]
+    camera_path: bool,
     /// Independent runs per method and budget (errors averaged, times median).
     #[arg(long, default_value_t = 1)]
     trials: u32,
@@ -421,6 +426,7 @@ fn main() -> ExitCode {
             methods: c.methods,
             budgets_ms: c.budgets_ms,
             frames: c.frames,
+            camera_path: c.camera_path,
             trials: c.trials,
             max_depth: c.max_depth,
             camera: c.camera,

@@ -14,7 +14,7 @@ use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Serie
 use crate::image_io::read_exr;
 use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, rel_squared_error, TRIMMED_SHARE};
 use crate::render::{Image, RenderSettings, RestirSettings, MAX_RESERVOIRS};
-use crate::scene::Scene;
+use crate::scene::{camera_on_path, Scene};
 
 pub struct CompareArgs {
     pub scene: PathBuf,
@@ -22,8 +22,11 @@ pub struct CompareArgs {
     pub methods: Vec<String>,
     /// GPU ms per frame; empty: ReSTIR PT's one-reservoir frame cost times 1, 2 and 4.
     pub budgets_ms: Vec<f64>,
-    /// Frames per run (static camera); the error is the last frame's.
+    /// Frames per run; the error is the last frame's.
     pub frames: u32,
+    /// The camera moves along the scene's camera path (`camera_on_path`) instead of staying at
+    /// `camera`; the reference is then of the last frame's camera.
+    pub camera_path: bool,
     /// Independent runs per method and budget; errors are averaged, times are medians.
     pub trials: u32,
     pub max_depth: u32,
@@ -80,6 +83,7 @@ const CALIBRATION_FRAMES: u32 = 8;
 struct Run<'a> {
     scene: &'a Scene,
     settings: &'a RenderSettings,
+    camera_path: bool,
 }
 
 /// What `Run::sequence` measured.
@@ -90,8 +94,17 @@ struct Sequence {
 }
 
 impl Run<'_> {
-    /// `frames` frames of a static camera from one seed: the median GPU ms per frame (from the
-    /// second frame on, once ReSTIR has a history), the failed-shift rate, and the last frame.
+    /// The camera of frame `frame`.
+    fn camera(&self, frame: u32) -> usize {
+        if self.camera_path {
+            camera_on_path(self.settings.camera, frame, self.scene.cameras.len())
+        } else {
+            self.settings.camera
+        }
+    }
+
+    /// `frames` frames from one seed: the median GPU ms per frame (from the second frame on,
+    /// once ReSTIR has a history), the failed-shift rate, and the last frame.
     fn sequence(&self, renderer: &mut MethodRenderer, frames: u32, seed: u32) -> Result<Sequence> {
         let settings = RenderSettings {
             seed,
@@ -100,7 +113,7 @@ impl Run<'_> {
         renderer.reset(self.scene, &settings)?;
         let (mut times, mut failed, mut last) = (vec![], vec![], None);
         for f in 0..frames {
-            let (outcome, image) = renderer.frame(self.scene, &settings, settings.camera, f)?;
+            let (outcome, image) = renderer.frame(self.scene, &settings, self.camera(f), f)?;
             if f > 0 || frames == 1 {
                 times.push(outcome.gpu_ms);
             }
@@ -270,7 +283,16 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     let run = Run {
         scene: &scene,
         settings: &settings,
+        camera_path: args.camera_path,
     };
+    if args.camera_path {
+        eprintln!(
+            "camera path: frame {} sees camera {}; {} must be a reference of that camera",
+            args.frames - 1,
+            run.camera(args.frames - 1),
+            args.reference.display()
+        );
+    }
     let mut renderers = vec![];
     for m in &methods {
         let mut renderer = MethodRenderer::new(&ctx, &scene, &settings, m)?;
@@ -359,14 +381,8 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     }
 
     write_csv(&args.out_dir.join("results.csv"), &rows)?;
-    let title = format!(
-        "{} {}x{}, frame {} of a static camera, {}",
-        path.display(),
-        width,
-        height,
-        args.frames,
-        ctx.info.name
-    );
+    let motion = if args.camera_path { "a moving camera" } else { "a static camera" };
+    let title = format!("{} {}x{}, frame {} of {motion}, {}", path.display(), width, height, args.frames, ctx.info.name);
     for (metric, name, value) in [
         ("rel_mse", "relMSE", (|r: &CompareRow| r.rel_mse) as fn(&CompareRow) -> f64),
         ("mse", "MSE", |r| r.mse),

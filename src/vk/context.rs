@@ -83,6 +83,8 @@ pub struct Context {
     pub info: DeviceInfo,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation_log: Arc<ValidationLog>,
+    /// Compute pipelines created on this device (see `pipelines_created`).
+    pipelines: std::sync::atomic::AtomicU64,
     pub instance: ash::Instance,
     _entry: ash::Entry,
 }
@@ -211,6 +213,7 @@ impl Context {
             info,
             debug,
             validation_log,
+            pipelines: std::sync::atomic::AtomicU64::new(0),
             instance,
             _entry: entry,
         })
@@ -243,6 +246,16 @@ impl Context {
     }
 
     /// Checks a storage binding against maxStorageBufferRange before anything is allocated.
+    /// The compute pipelines created on this device so far: a renderer creates all of its
+    /// own at start-up, so a run's count stays put across its frames.
+    pub fn pipelines_created(&self) -> u64 {
+        self.pipelines.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    pub(super) fn count_pipeline(&self) {
+        self.pipelines.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
     pub fn check_binding_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
         if bytes > self.info.max_storage_buffer_range {
             return Err(GpuError::BindingTooLarge {

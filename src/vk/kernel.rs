@@ -1,6 +1,5 @@
 //! A compute pipeline with one descriptor set of buffers and an optional push-constant block.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -23,15 +22,6 @@ impl Binding {
             Binding::Storage => vk::DescriptorType::STORAGE_BUFFER,
         }
     }
-}
-
-/// Compute pipelines created by this process, counted so that tests can show a run creates none
-/// after its start-up.
-static PIPELINES_CREATED: AtomicU64 = AtomicU64::new(0);
-
-/// The number of compute pipelines this process has created so far.
-pub fn pipelines_created() -> u64 {
-    PIPELINES_CREATED.load(Ordering::Relaxed)
 }
 
 /// What building one kernel cost, in wall-clock milliseconds per stage. Drivers may compile at
@@ -158,7 +148,7 @@ impl Kernel {
         let pipeline_info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(kernel.layout)];
         kernel.pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &pipeline_info, None) }
             .map_err(|(_, e)| vk_error("creating a compute pipeline")(e))?[0];
-        PIPELINES_CREATED.fetch_add(1, Ordering::Relaxed);
+        ctx.count_pipeline();
 
         let mut sizes = Vec::new();
         for kind in [Binding::Uniform, Binding::Storage] {

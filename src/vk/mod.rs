@@ -8,6 +8,6 @@ mod timer;
 
 pub use buffer::{Buffer, BufferUsage};
 pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
-pub use kernel::{pipelines_created, record_compute_barrier, Binding, Kernel, KernelCompile};
+pub use kernel::{record_compute_barrier, Binding, Kernel, KernelCompile};
 pub use shader::{compile_kernel, glsl_source};
 pub use timer::PassTimer;

@@ -13,7 +13,7 @@
 use std::sync::atomic::AtomicBool;
 
 use restir_pt::metrics::{mse, rel_mse};
-use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind};
+use restir_pt::render::{Image, PassKernel, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind};
 use restir_pt::scene::{load_scene, Scene};
 
 use crate::common::{assert_clean, gpu, repo_path};
@@ -432,6 +432,36 @@ fn restir_same_seed_is_bit_identical() {
     let (first, again, other) = (chain(7), chain(7), chain(8));
     assert_eq!(first, again, "the same seed must give the same bits");
     assert_ne!(first, other, "another seed must give another image");
+    assert_clean(&ctx);
+}
+
+// Every kernel is built and compiled when the renderer is made (llvmpipe compiles at the first
+// dispatch), and no frame creates a pipeline: not a moving camera, an unmoved one, a change of
+// the reservoirs per pixel or a restart.
+#[test]
+fn restir_compiles_every_kernel_at_start_up_and_none_in_frames() {
+    let ctx = gpu();
+    let (scene, small) = cornell_32_from_camera_0();
+    let mut renderer = Restir::new(&ctx, &scene, &small, &RestirSettings::default()).unwrap();
+    let created = ctx.pipelines_created();
+    assert_eq!(created, PassKernel::ALL.len() as u64);
+    let reports = renderer.compile_reports();
+    assert_eq!(reports.len(), PassKernel::ALL.len());
+    for k in &reports {
+        assert!(k.spirv_bytes > 0 && k.first_dispatch_ms > 0.0 && k.total_ms() >= k.first_dispatch_ms, "{k:?}");
+    }
+    for camera in 0..4 {
+        renderer.frame(&scene, camera, false).unwrap();
+    }
+    for _ in 0..2 {
+        renderer.frame(&scene, 3, true).unwrap();
+    }
+    renderer.set_reservoirs(2).unwrap();
+    renderer.reset(3).unwrap();
+    for camera in [0, 1, 1] {
+        renderer.frame(&scene, camera, false).unwrap();
+    }
+    assert_eq!(ctx.pipelines_created(), created, "a frame created a pipeline");
     assert_clean(&ctx);
 }
 
