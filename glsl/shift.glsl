@@ -91,8 +91,8 @@ void direction(Vertex from, Vertex to, out vec3 dir, out float dist) {
 }
 
 bool visible(Vertex from, Vertex to) {
-    if (!vertex_is_escaped(to)) return !segment_occluded(from.pos, from.normal, to.pos, to.normal);
-    vec3 origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal);
+    if (!vertex_is_escaped(to)) return !segment_occluded(from.pos, from.normal, from.triangle, to.pos, to.normal, to.triangle);
+    vec3 origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal, triangles[from.triangle]);
     return !trace_occluded(origin, to.pos, SHIFT_RAY_TMAX);
 }
 
@@ -144,7 +144,7 @@ bool bsdf_vertex(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSampl
     s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
     if (s.lobe == LOBE_NONE) return false;
     vec3 side = dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal;
-    Hit hit = trace_closest(offset_ray_origin(x.pos, side), s.wi, SHIFT_RAY_TMAX);
+    Hit hit = trace_closest(offset_ray_origin(x.pos, side, triangles[x.triangle]), s.wi, SHIFT_RAY_TMAX);
     next = hit.triangle == NO_HIT ? vertex_escaped(s.wi) : hit_vertex(hit);
     return true;
 }

@@ -9,6 +9,7 @@ mod cli;
 mod furnace;
 mod gris;
 mod layout;
+mod ray_offset;
 mod restir;
 mod rng_oracle;
 mod robustness;
