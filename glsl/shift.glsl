@@ -62,7 +62,7 @@ bool vertex_is_rough(Vertex v, ShiftParams params) {
     float w_d, w_c, w_t;
     lobe_weights(m, w_d, w_c, w_t);
     bool rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
-    return (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || rough_ggx);
+    return (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)));
 }
 
 bool is_reconnectable(Vertex prev, Vertex cur, ShiftParams params) {

@@ -16,7 +16,7 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
 use crate::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::NO_EMITTER;
 use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
@@ -152,7 +152,8 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
     let (_, w_c, w_t) = lobe_weights(m);
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
-    (w_c <= 0.0 && w_t <= 0.0) || rough_ggx
+    // An index-matched dielectric is a pass-through, a delta lobe at any roughness.
+    (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)))
 }
 
 /// The reconnection test for the pair (prev, cur): both rough and far enough apart.

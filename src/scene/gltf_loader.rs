@@ -229,7 +229,8 @@ impl<'a> Loader<'a> {
             ("emissiveFactor", emissive.iter().all(|v| v.is_finite() && *v >= 0.0)),
             ("emissiveStrength", strength.is_finite() && strength >= 0.0),
             ("transmissionFactor", (0.0..=1.0).contains(&transmission)),
-            ("ior", ior.is_finite() && ior >= 1.0),
+            // Within rounding below 1 is index-matched (docs/materials.md), not an error.
+            ("ior", ior.is_finite() && (ior >= 1.0 || crate::bsdf::index_matched(ior))),
         ];
         if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
             bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));

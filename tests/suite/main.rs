@@ -6,6 +6,7 @@ mod common;
 mod bsdf_oracle;
 mod bvh_oracle;
 mod cli;
+mod dielectric_furnace;
 mod furnace;
 mod gris;
 mod layout;
