@@ -10,7 +10,7 @@ use restir_pt::gpu_types::Material;
 
 use crate::common::{assert_clean, gpu, run_oracle, TestRng};
 
-pub const IORS: [f32; 8] = [1.0, 1.0 + 1e-6, 1.0 - 1e-6, 1.0001, 1.01, 1.33, 1.5, 1.0 / 1.5];
+pub const IORS: [f32; 9] = [1.0, 1.0 + 1e-6, 1.0 - 1e-6, 1.0001, 1.01, 1.33, 1.5, 2.4, 1.0 / 1.5];
 pub const ROUGHNESSES: [f32; 5] = [0.0, 0.01, 0.1, 0.5, 1.0];
 /// |cos| of wo; each is used from outside (+) and inside (-).
 const COSINES: [f32; 4] = [1.0, 0.7, 0.4, 0.15];
@@ -24,7 +24,7 @@ fn energy_floor(roughness: f32) -> f32 {
         r if r * r < DELTA_ALPHA => 1.0 - 1e-5,
         r if r <= 0.1 => 0.985,
         r if r <= 0.5 => 0.62,
-        _ => 0.33,
+        _ => 0.28,
     }
 }
 
