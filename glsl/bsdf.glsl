@@ -23,6 +23,13 @@
 // ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
 const float DELTA_ALPHA = 1e-3;
 
+// Relative IORs this close to 1 (2^-16) are index-matched: the interface neither reflects nor
+// bends light, and the dielectric lobe is an exact pass-through whatever the roughness. Closer to
+// 1 the generalized half-vector wi * eta + wo, of length about |eta - 1|, is lost in rounding.
+const float INDEX_MATCHED_TOLERANCE = 1.0 / 65536.0;
+
+bool index_matched(float eta) { return abs(eta - 1.0) <= INDEX_MATCHED_TOLERANCE; }
+
 const uint LOBE_NONE = 0u;
 const uint LOBE_DIFFUSE = 1u;
 const uint LOBE_CONDUCTOR = 2u;
@@ -129,6 +136,7 @@ void dielectric_eval_pdf(vec3 wo, vec3 wi, float alpha, float eta, out float f_c
     } else {
         float denom = dot(wi, wm) + dot(wo, wm) / etap;
         denom *= denom;
+        if (!(denom > 0.0)) return;
         f_cos = d * (1.0 - fr) * g * abs(dot(wi, wm) * dot(wo, wm) / (cos_o * denom)) / (etap * etap);
         pdf = vis * abs(dot(wi, wm)) / denom * (1.0 - fr);
     }
@@ -156,7 +164,7 @@ void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float
         f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
         pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
     }
-    if (BSDF_DIELECTRIC != 0 && w_t > 0.0 && alpha >= DELTA_ALPHA) {
+    if (BSDF_DIELECTRIC != 0 && w_t > 0.0 && alpha >= DELTA_ALPHA && !index_matched(m.ior)) {
         float fc, p;
         dielectric_eval_pdf(wo, wi, alpha, m.ior, fc, p);
         f_cos += w_t * m.base_color * fc;
@@ -211,6 +219,13 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
         wi = wi_s * vec3(1.0, 1.0, side);
     } else if (BSDF_DIELECTRIC != 0 && w_t > 0.0) {
         lobe = LOBE_DIELECTRIC;
+        if (index_matched(m.ior)) {
+            s.wi = -wo_world;
+            s.weight = m.base_color;
+            s.pdf = w_t;
+            s.lobe = LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION;
+            return s;
+        }
         if (alpha < DELTA_ALPHA) {
             float fr = fresnel_dielectric(wo.z, m.ior);
             if (u.w < fr) {

@@ -4,6 +4,7 @@
 #define BVH_GLSL
 
 #include "loop_budget.glsl"
+#include "ray_offset.glsl"
 #include "types.glsl"
 
 const uint NO_HIT = 0xffffffffu;
@@ -96,42 +97,26 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
 Hit trace_closest(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, false); }
 bool trace_occluded(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, true).triangle != NO_HIT; }
 
-// Moves a ray origin off a surface by a few ulps along the normal, robust at any scale
-// (Wächter and Binder, Ray Tracing Gems ch. 6).
-vec3 offset_ray_origin(vec3 p, vec3 n) {
-    const float origin = 1.0 / 32.0;
-    const float float_scale = 1.0 / 65536.0;
-    const float int_scale = 256.0;
-    ivec3 of_i = ivec3(int_scale * n);
-    vec3 p_i = vec3(
-        intBitsToFloat(floatBitsToInt(p.x) + (p.x < 0.0 ? -of_i.x : of_i.x)),
-        intBitsToFloat(floatBitsToInt(p.y) + (p.y < 0.0 ? -of_i.y : of_i.y)),
-        intBitsToFloat(floatBitsToInt(p.z) + (p.z < 0.0 ? -of_i.z : of_i.z)));
-    return vec3(
-        abs(p.x) < origin ? p.x + float_scale * n.x : p_i.x,
-        abs(p.y) < origin ? p.y + float_scale * n.y : p_i.y,
-        abs(p.z) < origin ? p.z + float_scale * n.z : p_i.z);
-}
-
 // Segment tests stop this fraction short of their (offset) end point.
 const float SEGMENT_EPSILON = 1e-4;
 
-// The shadow ray of the segment between surface points p (normal np) and q (normal nq). Both
-// ends are offset off their surfaces, each towards the other, and the ray runs between the
-// offset points: offsetting one end only moves a grazing far hit by more than any epsilon.
-void segment_ray(vec3 p, vec3 np, vec3 q, vec3 nq, out vec3 origin, out vec3 dir, out float tmax) {
+// The shadow ray of the segment between surface points p (normal np, on triangle index tp) and q
+// (normal nq, on triangle index tq). Both ends are offset off their surfaces, each towards the
+// other, and the ray runs between the offset points: offsetting one end only moves a grazing far
+// hit by more than any epsilon.
+void segment_ray(vec3 p, vec3 np, uint tp, vec3 q, vec3 nq, uint tq, out vec3 origin, out vec3 dir, out float tmax) {
     vec3 d = q - p;
-    origin = offset_ray_origin(p, dot(d, np) > 0.0 ? np : -np);
-    vec3 target = offset_ray_origin(q, dot(d, nq) < 0.0 ? nq : -nq);
+    origin = offset_ray_origin(p, dot(d, np) > 0.0 ? np : -np, triangles[tp]);
+    vec3 target = offset_ray_origin(q, dot(d, nq) < 0.0 ? nq : -nq, triangles[tq]);
     dir = target - origin;
     tmax = 1.0 - SEGMENT_EPSILON;
 }
 
-// Whether anything blocks the segment between surface points p (normal np) and q (normal nq).
-bool segment_occluded(vec3 p, vec3 np, vec3 q, vec3 nq) {
+// Whether anything blocks the segment between surface points p and q (see segment_ray).
+bool segment_occluded(vec3 p, vec3 np, uint tp, vec3 q, vec3 nq, uint tq) {
     vec3 origin, dir;
     float tmax;
-    segment_ray(p, np, q, nq, origin, dir, tmax);
+    segment_ray(p, np, tp, q, nq, tq, origin, dir, tmax);
     return trace_occluded(origin, dir, tmax);
 }
 

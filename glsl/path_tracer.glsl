@@ -16,11 +16,12 @@ const float RR_MAX_SURVIVAL = 0.95;
 const uint RR_START_DEPTH = 3u;
 
 
-// Whether the light sample is hidden from the shading point x (geometric normal ng).
-bool shadow_ray_occluded(vec3 x, vec3 ng, LightSample ls) {
-    if (ls.triangle == NO_EMITTER) return trace_occluded(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng), ls.dir, RAY_TMAX);
+// Whether the light sample is hidden from the shading point x (geometric normal ng, on triangle
+// index tri).
+bool shadow_ray_occluded(vec3 x, vec3 ng, uint tri, LightSample ls) {
+    if (ls.triangle == NO_EMITTER) return trace_occluded(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng, triangles[tri]), ls.dir, RAY_TMAX);
     Triangle light = triangles[ls.triangle];
-    return segment_occluded(x, ng, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)));
+    return segment_occluded(x, ng, tri, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)), ls.triangle);
 }
 
 struct PathState {
@@ -77,7 +78,7 @@ bool path_step(inout PathState s) {
         float bsdf_pdf;
         vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
-            if (!shadow_ray_occluded(x, ng, ls)) {
+            if (!shadow_ray_occluded(x, ng, hit.triangle, ls)) {
                 s.radiance += s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
             }
         }
@@ -93,7 +94,7 @@ bool path_step(inout PathState s) {
         if (ul.w >= survive) return false;
         s.beta /= survive;
     }
-    s.origin = offset_ray_origin(x, dot(bs.wi, ng) > 0.0 ? ng : -ng);
+    s.origin = offset_ray_origin(x, dot(bs.wi, ng) > 0.0 ? ng : -ng, tri);
     s.dir = bs.wi;
     return true;
 }

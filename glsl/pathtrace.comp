@@ -13,6 +13,7 @@ layout(std430, set = 0, binding = 6) buffer AccumSq { vec4 accum_sq[]; };  // rg
 layout(std430, set = 0, binding = 7) buffer Status {
     uint max_loop_iterations;
     uint loop_budget_cut_groups;
+    uint nonfinite_paths;        // paths whose radiance or throughput is NaN or infinite
 };
 
 void main() {
@@ -23,10 +24,12 @@ void main() {
     vec3 sum = vec3(0.0);
     vec3 sum_sq = vec3(0.0);
     uint sample_index = 0u;
+    uint nonfinite = 0u;
     PathState path = path_begin(p, path_seed(pixel, sample_offset, render_seed));
     while (inside) {
         loop_tick();
         if (path_step(path)) continue;
+        if (any(isnan(path.radiance)) || any(isinf(path.radiance)) || any(isnan(path.beta)) || any(isinf(path.beta))) nonfinite += 1u;
         sum += path.radiance;
         sum_sq += path.radiance * path.radiance;
         sample_index += 1u;
@@ -40,8 +43,10 @@ void main() {
     }
     uint iterations = subgroup_loop_iterations();
     bool cut = subgroup_loop_budget_cut();
+    uint group_nonfinite = subgroupAdd(nonfinite);
     if (subgroupElect()) {
         atomicMax(max_loop_iterations, iterations);
         if (cut) atomicAdd(loop_budget_cut_groups, 1u);
+        if (group_nonfinite > 0u) atomicAdd(nonfinite_paths, group_nonfinite);
     }
 }

@@ -80,7 +80,7 @@ bool vertex_is_rough(Vertex v, ShiftParams params) {
     float w_d, w_c, w_t;
     lobe_weights(m, w_d, w_c, w_t);
     bool rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
-    return (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || rough_ggx);
+    return (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)));
 }
 
 bool is_reconnectable(Vertex prev, Vertex cur, ShiftParams params) {
@@ -113,9 +113,9 @@ void direction(Vertex from, Vertex to, out vec3 dir, out float dist) {
 // call inlines a whole traversal, and llvmpipe's compile time grows with the copies.
 void visibility_ray(Vertex from, Vertex to, out vec3 origin, out vec3 dir, out float tmax) {
     if (!vertex_is_escaped(to)) {
-        segment_ray(from.pos, from.normal, to.pos, to.normal, origin, dir, tmax);
+        segment_ray(from.pos, from.normal, from.triangle, to.pos, to.normal, to.triangle, origin, dir, tmax);
     } else {
-        origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal);
+        origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal, triangles[from.triangle]);
         dir = to.pos;
         tmax = SHIFT_RAY_TMAX;
     }
@@ -175,7 +175,7 @@ bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex ligh
 bool bsdf_ray(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out vec3 origin) {
     s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
     if (s.lobe == LOBE_NONE) return false;
-    origin = offset_ray_origin(x.pos, dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal);
+    origin = offset_ray_origin(x.pos, dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal, triangles[x.triangle]);
     return true;
 }
 

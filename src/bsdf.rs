@@ -11,6 +11,16 @@ use crate::sampling::{build_onb, pdf_cosine_hemisphere, sample_cosine_hemisphere
 /// are ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
 pub const DELTA_ALPHA: f32 = 1e-3;
 
+/// Relative IORs this close to 1 (2⁻¹⁶) are index-matched: the interface neither reflects nor
+/// bends light, and the dielectric lobe is an exact pass-through whatever the roughness. Closer
+/// to 1 the generalized half-vector wi η + wo, of length about |η − 1|, is lost in rounding.
+pub const INDEX_MATCHED_TOLERANCE: f32 = 1.0 / 65536.0;
+
+/// Twin of GLSL `index_matched`: whether relative IOR `eta` is within rounding of 1.
+pub fn index_matched(eta: f32) -> bool {
+    (eta - 1.0).abs() <= INDEX_MATCHED_TOLERANCE
+}
+
 pub const LOBE_NONE: u32 = 0;
 pub const LOBE_DIFFUSE: u32 = 1;
 pub const LOBE_CONDUCTOR: u32 = 2;
@@ -144,6 +154,9 @@ pub fn dielectric_eval_pdf(wo: Vec3, wi: Vec3, alpha: f32, eta: f32) -> (f32, f3
     } else {
         let denom = wi.dot(wm) + wo.dot(wm) / etap;
         let denom = denom * denom;
+        if !(denom > 0.0) {
+            return (0.0, 0.0);
+        }
         let f_cos = d * (1.0 - fr) * g * (wi.dot(wm) * wo.dot(wm) / (cos_o * denom)).abs() / (etap * etap);
         (f_cos, vis * wi.dot(wm).abs() / denom * (1.0 - fr))
     }
@@ -170,7 +183,7 @@ pub fn bsdf_eval_pdf_local(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
         pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
     }
-    if w_t > 0.0 && alpha >= DELTA_ALPHA {
+    if w_t > 0.0 && alpha >= DELTA_ALPHA && !index_matched(m.ior) {
         let (fc, p) = dielectric_eval_pdf(wo, wi, alpha, m.ior);
         f_cos += w_t * base * fc;
         pdf += w_t * p;
@@ -220,6 +233,14 @@ pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample
     } else {
         if w_t <= 0.0 {
             return BsdfSample::FAILED;
+        }
+        if index_matched(m.ior) {
+            return BsdfSample {
+                wi: -wo_world,
+                weight: base,
+                pdf: w_t,
+                lobe: LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION,
+            };
         }
         if alpha < DELTA_ALPHA {
             let fr = fresnel_dielectric(wo.z, m.ior);

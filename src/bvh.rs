@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::gpu_types::{BvhNode, Triangle, LEAF_COUNT_BITS, LEAF_COUNT_MASK};
+use crate::ray_offset::offset_ray_origin;
 
 pub const NO_HIT: u32 = u32::MAX;
 const SAH_BINS: usize = 16;
@@ -277,25 +278,13 @@ pub fn trace_occluded(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec
 pub const SEGMENT_EPSILON: f32 = 1e-4;
 
 /// Twin of GLSL `segment_occluded`: whether anything blocks the segment between surface points
-/// p (normal np) and q (normal nq). Both ends are offset off their surfaces, each towards the
-/// other: offsetting one end only moves a grazing far hit by more than any epsilon.
-pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: Vec3, q: Vec3, nq: Vec3) -> bool {
+/// p (normal np, on triangle index tp) and q (normal nq, on triangle index tq). Both ends are
+/// offset off their surfaces, each towards the other: offsetting one end only moves a grazing far
+/// hit by more than any epsilon.
+#[allow(clippy::too_many_arguments)]
+pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: Vec3, tp: u32, q: Vec3, nq: Vec3, tq: u32) -> bool {
     let d = q - p;
-    let origin = offset_ray_origin(p, if d.dot(np) > 0.0 { np } else { -np });
-    let target = offset_ray_origin(q, if d.dot(nq) < 0.0 { nq } else { -nq });
+    let origin = offset_ray_origin(p, if d.dot(np) > 0.0 { np } else { -np }, &triangles[tp as usize]);
+    let target = offset_ray_origin(q, if d.dot(nq) < 0.0 { nq } else { -nq }, &triangles[tq as usize]);
     trace_occluded(nodes, triangles, origin, target - origin, 1.0 - SEGMENT_EPSILON)
-}
-
-/// Twin of GLSL `offset_ray_origin` (Wächter and Binder, Ray Tracing Gems ch. 6).
-pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
-    const ORIGIN: f32 = 1.0 / 32.0;
-    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-    const INT_SCALE: f32 = 256.0;
-    let mut out = p;
-    for k in 0..3 {
-        let of_i = (INT_SCALE * n[k]) as i32;
-        let shifted = f32::from_bits((p[k].to_bits() as i32).wrapping_add(if p[k] < 0.0 { -of_i } else { of_i }) as u32);
-        out[k] = if p[k].abs() < ORIGIN { p[k] + FLOAT_SCALE * n[k] } else { shifted };
-    }
-    out
 }

@@ -17,6 +17,7 @@ pub mod image_io;
 pub mod lights;
 pub mod metrics;
 pub mod path_record;
+pub mod ray_offset;
 pub mod render;
 pub mod rng;
 pub mod sampling;

@@ -210,6 +210,10 @@ struct RenderCmd {
     /// Write the summary as JSON.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Write images that have NaN or infinite pixels (with a warning); without it such an
+    /// image is not written and the exit code is 1.
+    #[arg(long)]
+    allow_nonfinite: bool,
     #[command(flatten)]
     device: DeviceOpts,
 }
@@ -255,6 +259,9 @@ struct ReferenceCmd {
     /// Mean EXR; the variance goes next to it as <name>.variance.exr.
     #[arg(long)]
     out: PathBuf,
+    /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
+    #[arg(long)]
+    allow_nonfinite: bool,
     #[command(flatten)]
     device: DeviceOpts,
 }
@@ -391,6 +398,7 @@ fn main() -> ExitCode {
             png: r.png,
             variance: r.variance,
             report: r.report,
+            allow_nonfinite: r.allow_nonfinite,
             device: r.device.into(),
         }),
         Command::Info(i) => {
@@ -406,6 +414,7 @@ fn main() -> ExitCode {
             camera: r.camera,
             seed: r.seed,
             out: r.out,
+            allow_nonfinite: r.allow_nonfinite,
             device: r.device.into(),
         }),
         Command::Profile(p) => cli::profile(cli::ProfileArgs {

@@ -16,11 +16,12 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
-use crate::bvh::{offset_ray_origin, segment_occluded, trace_closest, trace_occluded, NO_HIT};
+use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::NO_EMITTER;
 use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
 use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
+use crate::ray_offset::offset_ray_origin;
 use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::sampling::balance_heuristic;
 use crate::scene::Scene;
@@ -151,7 +152,8 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
     let (_, w_c, w_t) = lobe_weights(m);
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
-    (w_c <= 0.0 && w_t <= 0.0) || rough_ggx
+    // An index-matched dielectric is a pass-through, a delta lobe at any roughness.
+    (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)))
 }
 
 /// The reconnection test for the pair (prev, cur): both rough and far enough apart.
@@ -183,9 +185,19 @@ fn direction(from: &Vertex, to: &Vertex) -> (Vec3, f32) {
 
 fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
     if !to.is_escaped() {
-        return !segment_occluded(&scene.nodes, &scene.triangles, from.pos, from.normal, to.pos, to.normal);
+        return !segment_occluded(
+            &scene.nodes,
+            &scene.triangles,
+            from.pos,
+            from.normal,
+            from.triangle,
+            to.pos,
+            to.normal,
+            to.triangle,
+        );
     }
-    let origin = offset_ray_origin(from.pos, if to.pos.dot(from.normal) > 0.0 { from.normal } else { -from.normal });
+    let side = if to.pos.dot(from.normal) > 0.0 { from.normal } else { -from.normal };
+    let origin = offset_ray_origin(from.pos, side, &scene.triangles[from.triangle as usize]);
     !trace_occluded(&scene.nodes, &scene.triangles, origin, to.pos, 1e30)
 }
 
@@ -288,7 +300,13 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
                 return None;
             }
             let side = if s.wi.dot(x.normal) > 0.0 { x.normal } else { -x.normal };
-            let hit = trace_closest(&scene.nodes, &scene.triangles, offset_ray_origin(x.pos, side), s.wi, 1e30);
+            let hit = trace_closest(
+                &scene.nodes,
+                &scene.triangles,
+                offset_ray_origin(x.pos, side, &scene.triangles[x.triangle as usize]),
+                s.wi,
+                1e30,
+            );
             let next = if hit.triangle == NO_HIT {
                 Vertex::escaped(s.wi)
             } else {

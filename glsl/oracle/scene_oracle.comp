@@ -1,6 +1,6 @@
 #version 460
 // Oracle kernel: BVH traversal, light sampling and camera rays against a real scene
-// (twins: src/bvh.rs, src/lights.rs, src/scene/camera.rs).
+// (twins: src/bvh.rs, src/ray_offset.rs, src/lights.rs, src/scene/camera.rs).
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
@@ -25,7 +25,7 @@ void main() {
     bool occluded = trace_occluded(o.xyz, d, o.w);
     LightSample ls = sample_light(o.xyz, u);
     outputs[5u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
-    outputs[5u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d));
+    outputs[5u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d, triangles[i % uint(triangles.length())]));
     outputs[5u * i + 2u] = vec4(ls.dir, ls.dist);
     outputs[5u * i + 3u] = vec4(ls.radiance, ls.pdf);
     outputs[5u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), uintBitsToFloat(ls.triangle));

@@ -370,6 +370,12 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
                     .map(|f| format!(" | failed shifts {:.2}%", 100.0 * f))
                     .unwrap_or_default()
             );
+            if row.nonfinite_pixels > 0 {
+                eprintln!(
+                    "warning: {} at {budget} ms: {} non-finite pixels in its last frames (results.csv)",
+                    row.method, row.nonfinite_pixels
+                );
+            }
             images.push((label.clone(), budget, last.expect("at least one trial")));
             rows.push(row);
         }

@@ -60,7 +60,13 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene) {
         scene.emitter_power
     );
     println!("environment: {:?}", scene.environment.to_array());
-    println!("bounds: {:?} .. {:?} (extent {:.4})", lo.to_array(), hi.to_array(), scene.extent());
+    println!(
+        "bounds: {:?} .. {:?} (extent {:.4}), relative to the first camera at {:?} (world)",
+        lo.to_array(),
+        hi.to_array(),
+        scene.extent(),
+        scene.origin.to_array()
+    );
     println!("materials: {}", scene.materials.len());
     for (m, name) in scene.materials.iter().zip(&scene.material_names) {
         let used = scene

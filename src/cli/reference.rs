@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use super::render::{interrupt_flag, progress_bar};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
@@ -18,6 +18,8 @@ pub struct ReferenceArgs {
     pub camera: usize,
     pub seed: u32,
     pub out: PathBuf,
+    /// Write a reference with non-finite pixels (with a warning) instead of failing.
+    pub allow_nonfinite: bool,
     pub device: DeviceArgs,
 }
 
@@ -46,6 +48,17 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
     let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt_flag())?;
     bar.finish_and_clear();
     let image = tracer.image()?;
+    let nonfinite = image.non_finite_count();
+    if nonfinite > 0 {
+        let what = format!("{nonfinite} non-finite pixels ({} non-finite path weights)", stats.nonfinite_paths);
+        if !args.allow_nonfinite {
+            bail!(
+                "{}: {what}; no reference written (--allow-nonfinite writes it anyway)",
+                path.display()
+            );
+        }
+        eprintln!("warning: {what}; writing the reference anyway (--allow-nonfinite)");
+    }
     let variance = variance_path(&args.out);
     write_exr(&args.out, image.width, image.height, &image.mean)?;
     write_exr(&variance, image.width, image.height, &image.variance)?;

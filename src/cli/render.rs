@@ -39,6 +39,8 @@ pub struct RenderArgs {
     pub png: Option<PathBuf>,
     pub variance: Option<PathBuf>,
     pub report: Option<PathBuf>,
+    /// Write images with non-finite pixels (with a warning) instead of failing.
+    pub allow_nonfinite: bool,
     pub device: DeviceArgs,
 }
 
@@ -56,6 +58,11 @@ pub struct RenderReport {
     pub paths_per_second: f64,
     /// Start-up milliseconds spent compiling the kernels (outside every frame's time).
     pub compile_ms: f64,
+    /// NaN or infinite pixels of the image written (or refused) for this frame.
+    pub nonfinite_pixels: usize,
+    /// Path weights found NaN or infinite: the path tracer's paths with a non-finite radiance or
+    /// throughput over the whole render; ReSTIR PT's candidate and shift weights of this frame.
+    pub nonfinite_weights: u64,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub restir: Option<RestirFrameReport>,
 }
@@ -77,7 +84,7 @@ pub(super) fn print_compile_summary(kernels: &[crate::vk::KernelCompile]) {
 impl RenderReport {
     pub fn summary_line(&self) -> String {
         format!(
-            "{} | {} | {}x{} | {} spp | depth {} | GPU {:.1} ms | wall {:.1} ms | {:.3} M paths/s",
+            "{} | {} | {}x{} | {} spp | depth {} | GPU {:.1} ms | wall {:.1} ms | {:.3} M paths/s | non-finite pixels {}, weights {}",
             self.device,
             self.method,
             self.width,
@@ -86,9 +93,32 @@ impl RenderReport {
             self.max_depth,
             self.gpu_ms,
             self.wall_ms,
-            self.paths_per_second * 1e-6
+            self.paths_per_second * 1e-6,
+            self.nonfinite_pixels,
+            self.nonfinite_weights
         )
     }
+}
+
+/// Refuses an image with non-finite pixels unless --allow-nonfinite: the report (if asked for)
+/// is written first so that the counts are kept, then the error names the frame and the counts.
+/// With --allow-nonfinite it warns and lets the image be written.
+fn guard_nonfinite(args: &RenderArgs, frame: u32, report: &RenderReport) -> Result<()> {
+    if report.nonfinite_pixels == 0 {
+        return Ok(());
+    }
+    let what = format!(
+        "frame {frame}: {} non-finite pixels ({} non-finite path weights)",
+        report.nonfinite_pixels, report.nonfinite_weights
+    );
+    if args.allow_nonfinite {
+        eprintln!("warning: {what}; writing the image anyway (--allow-nonfinite)");
+        return Ok(());
+    }
+    if let Some(r) = &args.report {
+        std::fs::write(r, serde_json::to_string_pretty(report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
+    }
+    bail!("{what}; no image written (--allow-nonfinite writes it anyway)")
 }
 
 pub(super) fn progress_bar(total: u32) -> indicatif::ProgressBar {
@@ -259,7 +289,6 @@ fn render_path_traced(
         let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
         bar.finish_and_clear();
         let image = tracer.image()?;
-        outputs.write_frame(frame, &image)?;
         let frame_report = RenderReport {
             device: ctx.info.name.clone(),
             scene: path.display().to_string(),
@@ -272,9 +301,13 @@ fn render_path_traced(
             wall_ms: stats.wall_ms,
             paths_per_second: stats.paths_per_second(settings.pixel_count()),
             compile_ms: compile.total_ms(),
+            nonfinite_pixels: image.non_finite_count(),
+            nonfinite_weights: stats.nonfinite_paths,
             restir: None,
         };
         println!("{}{}", frame_prefix(args, frame), frame_report.summary_line());
+        guard_nonfinite(args, frame, &frame_report)?;
+        outputs.write_frame(frame, &image)?;
         if stats.interrupted {
             eprintln!("interrupted: writing the {} spp of frame {frame} accumulated so far", stats.spp);
         }
@@ -351,7 +384,6 @@ fn render_restir(
     for frame in 0..args.frames {
         let stats = renderer.frame(scene, frame_camera(args, frame, scene.cameras.len()), args.static_camera)?;
         let image = renderer.image()?;
-        outputs.write_frame(frame, &image)?;
         let frame_ms = stats.gpu_ms().unwrap_or(stats.wall_ms);
         gpu_ms += frame_ms;
         let detail = RestirFrameReport::from_stats(frame + 1, &stats);
@@ -367,6 +399,8 @@ fn render_restir(
             wall_ms: stats.wall_ms,
             paths_per_second: settings.pixel_count() as f64 * (restir.candidates * restir.reservoirs) as f64 / (frame_ms * 1e-3),
             compile_ms: compile_reports.iter().map(|k| k.total_ms()).sum(),
+            nonfinite_pixels: image.non_finite_count(),
+            nonfinite_weights: detail.nonfinite_weights as u64,
             restir: Some(detail.clone()),
         };
         println!(
@@ -375,6 +409,8 @@ fn render_restir(
             frame_report.summary_line(),
             detail.summary()
         );
+        guard_nonfinite(args, frame, &frame_report)?;
+        outputs.write_frame(frame, &image)?;
         let interrupted = interrupt.load(Ordering::Relaxed);
         if interrupted {
             eprintln!("interrupted: writing frame {frame}");

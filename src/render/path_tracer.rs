@@ -20,14 +20,18 @@ const MAX_CHUNK_GROWTH: u32 = 8;
 /// Share of a driver's per-invocation loop budget a dispatch may plan to use; the rest absorbs
 /// pixels whose paths cost more than the ones measured so far.
 const LOOP_BUDGET_SHARE: f64 = 0.25;
-/// Words of glsl/pathtrace.comp's Status block: max loop iterations, subgroups with a cut loop.
-const STATUS_WORDS: u64 = 2;
+/// Words of glsl/pathtrace.comp's Status block: max loop iterations, subgroups with a cut loop,
+/// paths with a non-finite radiance or throughput.
+const STATUS_WORDS: u64 = 3;
 const LOCAL_SIZE: u32 = 8;
 
 pub struct RenderStats {
     pub spp: u32,
     pub gpu_ms: f64,
     pub wall_ms: f64,
+    /// Paths whose radiance or throughput was NaN or infinite (counted on the GPU); each one
+    /// makes its pixel non-finite.
+    pub nonfinite_paths: u64,
     /// True if the render stopped early on request (Ctrl-C); the image holds what was done.
     pub interrupted: bool,
 }
@@ -118,8 +122,9 @@ impl PathTracer {
     }
 
     /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the
-    /// device has no timestamps) and the most loop iterations any subgroup ran.
-    pub fn dispatch(&mut self, samples: u32) -> Result<(Option<f64>, u32)> {
+    /// device has no timestamps), the most loop iterations any subgroup ran and the number of
+    /// paths with a non-finite radiance or throughput.
+    pub fn dispatch(&mut self, samples: u32) -> Result<(Option<f64>, u32, u32)> {
         let mut params = self.base_params;
         params.sample_offset = self.samples_done;
         params.samples_per_dispatch = samples;
@@ -140,7 +145,7 @@ impl PathTracer {
             })
             .context("path tracing")?;
         let status = self.status.read::<u32>(STATUS_WORDS as usize)?;
-        let (iterations, cut_groups) = (status[0], status[1]);
+        let (iterations, cut_groups, nonfinite) = (status[0], status[1], status[2]);
         if cut_groups > 0 {
             let limit = self.ctx.info.loop_iteration_limit.unwrap_or(0);
             return Err(GpuError::LoopLimit {
@@ -151,7 +156,7 @@ impl PathTracer {
             .into());
         }
         self.samples_done += samples;
-        Ok((self.timer.read_ms(1)?.map(|t| t[0]), iterations))
+        Ok((self.timer.read_ms(1)?.map(|t| t[0]), iterations, nonfinite))
     }
 
     /// The largest chunk the driver's loop budget allows, from the last dispatch's cost.
@@ -172,6 +177,7 @@ impl PathTracer {
         let mut gpu_ms = 0.0;
         let mut chunk = 1u32;
         let mut interrupted = false;
+        let mut nonfinite_paths = 0u64;
         let target_ms = if self.ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU {
             TARGET_SUBMISSION_MS_CPU
         } else {
@@ -184,7 +190,8 @@ impl PathTracer {
             }
             let samples = chunk.min(self.settings.spp - self.samples_done);
             let t0 = Instant::now();
-            let (ms, iterations) = self.dispatch(samples)?;
+            let (ms, iterations, nonfinite) = self.dispatch(samples)?;
+            nonfinite_paths += nonfinite as u64;
             let ms = ms.unwrap_or_else(|| t0.elapsed().as_secs_f64() * 1e3);
             gpu_ms += ms;
             progress(self.samples_done);
@@ -197,6 +204,7 @@ impl PathTracer {
             spp: self.samples_done,
             gpu_ms,
             wall_ms: start.elapsed().as_secs_f64() * 1e3,
+            nonfinite_paths,
             interrupted,
         })
     }

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use glam::{Mat4, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 
 use super::{Camera, Scene, SceneParts};
 use crate::gpu_types::{Material, Triangle, MATERIAL_DOUBLE_SIDED, NO_EMITTER};
@@ -25,6 +25,10 @@ struct Loader<'a> {
     /// Index of the glTF default material in `materials`, added on first use.
     default_material: Option<u32>,
     cameras: Vec<Camera>,
+    /// Mesh instances with their world transforms, added once the origin is known.
+    instances: Vec<(gltf::Mesh<'a>, DMat4)>,
+    /// World position of the scene's coordinate origin: the first camera (see `walk_nodes`).
+    origin: DVec3,
     warnings: Vec<String>,
     degenerate: usize,
     degenerate_emitters: usize,
@@ -64,6 +68,8 @@ pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> 
         material_names: Vec::new(),
         default_material: None,
         cameras: Vec::new(),
+        instances: Vec::new(),
+        origin: DVec3::ZERO,
         warnings: Vec::new(),
         degenerate: 0,
         degenerate_emitters: 0,
@@ -72,7 +78,7 @@ pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> 
     let scene = gltf.document.default_scene().or_else(|| gltf.document.scenes().next());
     let scene = scene.ok_or_else(|| problem(path, "the file has no scene"))?;
     loader.walk_nodes(&scene)?;
-    let environment = scene_environment(path, &scene)?;
+    let environment = scene_environment(path, &scene, &gltf.document)?;
     loader.finish(environment)
 }
 
@@ -141,30 +147,32 @@ fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
     })
 }
 
-fn scene_environment(path: &Path, scene: &gltf::Scene) -> Result<Vec3> {
-    let Some(raw) = scene.extras().as_ref() else {
-        return Ok(Vec3::ZERO);
-    };
-    let extras: serde_json::Value =
-        serde_json::from_str(raw.get()).map_err(|e| problem(path, format!("scene extras are not JSON: {e}")))?;
-    let Some(env) = extras.get("environment") else {
-        return Ok(Vec3::ZERO);
-    };
-    let values: Vec<f32> = env
-        .as_array()
-        .filter(|a| a.len() == 3)
-        .and_then(|a| a.iter().map(|v| v.as_f64().map(|x| x as f32)).collect())
-        .ok_or_else(|| problem(path, "scene extras \"environment\" must be [r, g, b]"))?;
-    if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
-        bail!(problem(
-            path,
-            format!("scene extras \"environment\" {values:?} must be finite and non-negative")
-        ));
+/// The constant environment: `"environment": [r, g, b]` in the scene's extras, else in the
+/// root's (exporters write either); black if neither has one.
+fn scene_environment(path: &Path, scene: &gltf::Scene, doc: &gltf::Document) -> Result<Vec3> {
+    let places = [("scene", scene.extras().as_ref()), ("root", doc.as_json().extras.as_ref())];
+    for (place, raw) in places {
+        let Some(raw) = raw else { continue };
+        let extras: serde_json::Value =
+            serde_json::from_str(raw.get()).map_err(|e| problem(path, format!("{place} extras are not JSON: {e}")))?;
+        let Some(env) = extras.get("environment") else { continue };
+        let values: Vec<f32> = env
+            .as_array()
+            .filter(|a| a.len() == 3)
+            .and_then(|a| a.iter().map(|v| v.as_f64().map(|x| x as f32)).collect())
+            .ok_or_else(|| problem(path, format!("{place} extras \"environment\" must be [r, g, b]")))?;
+        if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            bail!(problem(
+                path,
+                format!("{place} extras \"environment\" {values:?} must be finite and non-negative")
+            ));
+        }
+        return Ok(Vec3::from_slice(&values));
     }
-    Ok(Vec3::from_slice(&values))
+    Ok(Vec3::ZERO)
 }
 
-impl Loader<'_> {
+impl<'a> Loader<'a> {
     fn warn(&mut self, msg: impl std::fmt::Display) {
         self.warnings.push(format!("{}: {msg}", self.path.display()));
     }
@@ -221,7 +229,8 @@ impl Loader<'_> {
             ("emissiveFactor", emissive.iter().all(|v| v.is_finite() && *v >= 0.0)),
             ("emissiveStrength", strength.is_finite() && strength >= 0.0),
             ("transmissionFactor", (0.0..=1.0).contains(&transmission)),
-            ("ior", ior.is_finite() && ior >= 1.0),
+            // Within rounding below 1 is index-matched (docs/materials.md), not an error.
+            ("ior", ior.is_finite() && (ior >= 1.0 || crate::bsdf::index_matched(ior))),
         ];
         if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
             bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));
@@ -253,8 +262,11 @@ impl Loader<'_> {
         })
     }
 
-    fn walk_nodes(&mut self, scene: &gltf::Scene) -> Result<()> {
-        let mut stack: Vec<(gltf::Node, Mat4, usize)> = scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    /// Walks the hierarchy in f64 and re-centres the scene on its first camera: geometry is
+    /// uploaded in f32 camera-relative coordinates, so a scene far from the world origin keeps
+    /// the precision it has near the camera (as large-world engines do).
+    fn walk_nodes(&mut self, scene: &gltf::Scene<'a>) -> Result<()> {
+        let mut stack: Vec<(gltf::Node, DMat4, usize)> = scene.nodes().map(|n| (n, DMat4::IDENTITY, 0)).collect();
         stack.reverse();
         let mut visited = 0usize;
         while let Some((node, parent, depth)) = stack.pop() {
@@ -268,13 +280,13 @@ impl Loader<'_> {
             if visited > MAX_NODE_INSTANCES {
                 bail!(problem(self.path, format!("more than {MAX_NODE_INSTANCES} node instances")));
             }
-            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
             let world = parent * local;
             if !world.is_finite() {
                 bail!(problem(self.path, format!("node {} has a non-finite transform", node.index())));
             }
             if let Some(mesh) = node.mesh() {
-                self.add_mesh(&mesh, &world)?;
+                self.instances.push((mesh, world));
             }
             if let Some(camera) = node.camera() {
                 self.add_camera(&camera, &node, &world);
@@ -282,10 +294,13 @@ impl Loader<'_> {
             let children: Vec<_> = node.children().collect();
             stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
         }
+        for (mesh, world) in std::mem::take(&mut self.instances) {
+            self.add_mesh(&mesh, &world)?;
+        }
         Ok(())
     }
 
-    fn add_camera(&mut self, camera: &gltf::Camera, node: &gltf::Node, world: &Mat4) {
+    fn add_camera(&mut self, camera: &gltf::Camera, node: &gltf::Node, world: &DMat4) {
         match camera.projection() {
             gltf::camera::Projection::Perspective(p) if p.yfov().is_finite() && p.yfov() > 0.0 && p.yfov() < std::f32::consts::PI => {
                 let name = node
@@ -293,7 +308,12 @@ impl Loader<'_> {
                     .or(camera.name())
                     .map(str::to_string)
                     .unwrap_or_else(|| format!("camera {}", self.cameras.len()));
-                self.cameras.push(Camera::from_transform(name, world, p.yfov()));
+                if self.cameras.is_empty() {
+                    self.origin = world.transform_point3(DVec3::ZERO);
+                }
+                let mut relative = *world;
+                relative.w_axis -= self.origin.extend(0.0);
+                self.cameras.push(Camera::from_transform(name, &relative.as_mat4(), p.yfov()));
             }
             gltf::camera::Projection::Perspective(p) => {
                 self.warn(format!("camera on node {} has an invalid yfov {}; ignored", node.index(), p.yfov()))
@@ -302,7 +322,7 @@ impl Loader<'_> {
         }
     }
 
-    fn add_mesh(&mut self, mesh: &gltf::Mesh, world: &Mat4) -> Result<()> {
+    fn add_mesh(&mut self, mesh: &gltf::Mesh, world: &DMat4) -> Result<()> {
         // A mirroring transform flips the winding, and so which face is the front.
         let flip = world.determinant() < 0.0;
         for prim in mesh.primitives() {
@@ -352,9 +372,10 @@ impl Loader<'_> {
             };
             let emissive = Vec3::from(self.materials[material as usize].emission).max_element() > 0.0;
             for tri in indices.chunks_exact(3) {
-                let [a, b, c] = [0, 1, 2].map(|k| world.transform_point3(positions[tri[k] as usize]));
+                let [a, b, c] = [0, 1, 2].map(|k| world.transform_point3(positions[tri[k] as usize].as_dvec3()) - self.origin);
                 let (b, c) = if flip { (c, b) } else { (b, c) };
-                let (e1, e2) = (b - a, c - a);
+                let (e1, e2) = ((b - a).as_vec3(), (c - a).as_vec3());
+                let a = a.as_vec3();
                 let area2 = e1.cross(e2).length();
                 // Degenerate triangles carry no area: they cannot be hit or emit, and break normals.
                 if !(area2 > 1e-12 * (e1.length_squared() + e2.length_squared()).max(f32::MIN_POSITIVE)) || !area2.is_finite() {
@@ -437,7 +458,7 @@ impl Loader<'_> {
         if self.cameras.is_empty() {
             bail!(problem(self.path, "the scene has no perspective camera"));
         }
-        Ok(Scene::build(SceneParts {
+        let mut scene = Scene::build(SceneParts {
             source: self.path.to_path_buf(),
             triangles: self.triangles,
             materials: self.materials,
@@ -445,6 +466,8 @@ impl Loader<'_> {
             environment,
             cameras: self.cameras,
             warnings: self.warnings,
-        }))
+        });
+        scene.origin = self.origin;
+        Ok(scene)
     }
 }

@@ -6,7 +6,7 @@ mod gltf_loader;
 pub use camera::{camera_on_path, Camera};
 pub use gltf_loader::{load_scene, load_scene_from_bytes};
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
 use crate::bvh::Bvh;
@@ -28,7 +28,13 @@ pub struct Scene {
     pub environment: Vec3,
     pub env_select_prob: f32,
     pub cameras: Vec<Camera>,
+    /// Bounds of the triangles in scene coordinates.
     pub bounds: (Vec3, Vec3),
+    /// World position of the scene coordinates' origin. Loaded scenes are re-centred on their
+    /// first camera in f64 before rounding to f32 (camera-relative coordinates), so precision
+    /// near the camera does not depend on where the scene sits in the world; 0 for scenes built
+    /// directly.
+    pub origin: DVec3,
     /// Things the loader dropped or ignored; each line names the file.
     pub warnings: Vec<String>,
 }
@@ -91,6 +97,7 @@ impl Scene {
             env_select_prob,
             cameras: parts.cameras,
             bounds: (Vec3::from(root.lo), Vec3::from(root.hi)),
+            origin: DVec3::ZERO,
             warnings: parts.warnings,
         }
     }

@@ -2,10 +2,11 @@
 //! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
 
 use glam::{Vec3, Vec4};
-use restir_pt::bvh::{offset_ray_origin, trace_closest, trace_occluded, NO_HIT};
+use restir_pt::bvh::{trace_closest, trace_occluded, NO_HIT};
 use restir_pt::gltf_writer::MeshData;
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::lights::sample_light;
+use restir_pt::ray_offset::offset_ray_origin;
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::{Camera, Scene, SceneParts};
 use restir_pt::vk::{Buffer, BufferUsage};
@@ -136,7 +137,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         }
         let occluded = trace_occluded(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
         assert_eq!(g[1].x == 1.0, occluded, "trace_occluded, ray {i}");
-        let off = offset_ray_origin(o.truncate(), d);
+        let off = offset_ray_origin(o.truncate(), d, &scene.triangles[i % scene.triangles.len()]);
         for k in 0..3 {
             assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
         }

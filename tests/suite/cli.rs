@@ -369,3 +369,99 @@ fn cli_compare_writes_results_charts_and_strip() {
     );
     assert_clean_failure(&["compare", "scenes/cornell.gltf", "--reference", "missing.exr"], &["missing.exr"]);
 }
+
+/// A lamp of radiance 3e38 (finite, so the loader takes it) whose sums overflow to infinity.
+fn overflowing_lamp_scene() -> std::path::PathBuf {
+    use glam::Vec3;
+    use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+    let mut b = GltfBuilder::default();
+    let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
+    let lamp = b.material("lamp", MaterialSpec::emitter(Vec3::splat(3e38)));
+    let floor = b.mesh(
+        "floor",
+        &MeshData::quad(Vec3::new(-1.0, 0.0, -1.0), Vec3::Z * 2.0, Vec3::X * 2.0),
+        grey,
+    );
+    b.instance("floor", floor, 0.0, Vec3::ZERO);
+    let light = b.mesh(
+        "lamp",
+        &MeshData::quad(Vec3::new(-0.3, 1.0, -0.3), Vec3::X * 0.6, Vec3::Z * 0.6),
+        lamp,
+    );
+    b.instance("lamp", light, 0.0, Vec3::ZERO);
+    b.camera("camera", Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 0.9);
+    temp_file("overflow.gltf", b.finish("overflow", Vec3::ZERO).as_bytes())
+}
+
+#[test]
+fn cli_nonfinite_pixels_fail_the_render_unless_allowed() {
+    let scene = overflowing_lamp_scene();
+    let dir = scene.parent().unwrap();
+    for method in ["pt", "restir"] {
+        let (exr, report) = (dir.join(format!("{method}.exr")), dir.join(format!("{method}.json")));
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--method",
+            method,
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--out",
+            exr.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ];
+        if method == "pt" {
+            args.extend(["--spp", "4"]);
+        }
+        assert_clean_failure(&args, &["non-finite pixels", "--allow-nonfinite"]);
+        assert!(!exr.exists(), "{method}: an image with non-finite pixels was written");
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert!(json["nonfinite_pixels"].as_u64().unwrap() > 0, "{method}: report {json}");
+        assert!(json.get("nonfinite_weights").is_some(), "{method}: report {json}");
+        if method == "restir" {
+            // --allow-nonfinite takes the same path for both methods; one run of it suffices.
+            continue;
+        }
+        args.push("--allow-nonfinite");
+        let (code, stdout, stderr) = restir_pt(&args);
+        assert_eq!(code, 0, "{method} with --allow-nonfinite: {stderr}");
+        assert!(
+            stderr.contains("warning: frame 0:") && stderr.contains("non-finite pixels"),
+            "{stderr}"
+        );
+        assert!(stdout.contains("non-finite pixels"), "{stdout}");
+        let (_, _, pixels) = restir_pt::image_io::read_exr(&exr).unwrap();
+        assert!(pixels.iter().any(|p| !p.is_finite()), "{method}: the written image is finite");
+    }
+}
+
+#[test]
+fn cli_render_reports_zero_nonfinite_counts_on_a_clean_scene() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let report = dir.join("clean.json");
+    let (code, stdout, stderr) = restir_pt(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--method",
+        "pt",
+        "--spp",
+        "4",
+        "--out",
+        dir.join("clean.exr").to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("non-finite pixels 0, weights 0"), "{stdout}");
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(
+        (json["nonfinite_pixels"].as_u64(), json["nonfinite_weights"].as_u64()),
+        (Some(0), Some(0))
+    );
+}

@@ -156,8 +156,69 @@ fn loader_applies_node_transforms_and_mirroring_flips_the_front_face() {
         .iter()
         .find(|t| t.emitter != restir_pt::gpu_types::NO_EMITTER)
         .unwrap();
-    let v = light.vertices();
+    // Scene coordinates are relative to the first camera; scene.origin is its world position.
+    let v = light.vertices().map(|p| p.as_dvec3() + scene.origin);
     assert!(v.iter().all(|p| (p.y - 2.0).abs() < 1e-6), "light moved to y = -1 + 3: {v:?}");
     // The lamp faced down (-y); mirrored in y it faces up, and the winding must say so.
     assert!(light.normal_area2().y > 0.0);
+}
+
+#[test]
+fn loader_takes_the_environment_from_the_scene_extras_then_the_root_extras() {
+    let root_only = scene_file("root-env.gltf", floor(), None, |v| {
+        v["extras"] = json!({ "environment": [0.25, 0.5, 1.0] });
+    });
+    let scene = load_scene(&root_only).unwrap();
+    assert_eq!(scene.environment, Vec3::new(0.25, 0.5, 1.0));
+    assert_eq!(scene.env_select_prob, 1.0);
+    let both = scene_file("both-env.gltf", floor(), None, |v| {
+        v["extras"] = json!({ "environment": [0.25, 0.5, 1.0] });
+        v["scenes"][0]["extras"] = json!({ "environment": [2.0, 2.0, 2.0] });
+    });
+    assert_eq!(load_scene(&both).unwrap().environment, Vec3::splat(2.0));
+    // The scene's extras without an environment do not hide the root's.
+    let other_scene_extras = scene_file("other-extras.gltf", floor(), None, |v| {
+        v["extras"] = json!({ "environment": [1.0, 1.0, 1.0] });
+        v["scenes"][0]["extras"] = json!({ "author": "someone" });
+    });
+    assert_eq!(load_scene(&other_scene_extras).unwrap().environment, Vec3::ONE);
+    let bad_root = scene_file("bad-root-env.gltf", floor(), None, |v| {
+        v["extras"] = json!({ "environment": [1.0, -1.0, 1.0] });
+    });
+    let err = load_error(&bad_root);
+    assert!(err.contains("bad-root-env.gltf") && err.contains("root extras"), "{err}");
+}
+
+#[test]
+fn loader_recentres_the_scene_on_its_first_camera_in_f64() {
+    let far = 1e5f64;
+    let moved = scene_file("far.gltf", floor(), Some(lamp()), |v| {
+        let roots = v["scenes"][0]["nodes"].clone();
+        let nodes = v["nodes"].as_array_mut().unwrap();
+        nodes.push(json!({ "children": roots, "translation": [far, 0.0, -far] }));
+        v["scenes"][0]["nodes"] = json!([nodes.len() - 1]);
+    });
+    let near = load_scene(&scene_file("near.gltf", floor(), Some(lamp()), |_| {})).unwrap();
+    let far_scene = load_scene(&moved).unwrap();
+    assert_eq!(far_scene.origin, near.origin + glam::DVec3::new(far, 0.0, -far));
+    assert_eq!(far_scene.cameras[0].position, Vec3::ZERO);
+    // Camera-relative coordinates are the same wherever the scene sits.
+    let sorted = |s: &restir_pt::scene::Scene| {
+        let mut v: Vec<[u32; 9]> = s
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.vertices();
+                [a, b, c]
+                    .map(|p| p.to_array())
+                    .concat()
+                    .try_into()
+                    .map(|x: [f32; 9]| x.map(f32::to_bits))
+                    .unwrap()
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(sorted(&far_scene), sorted(&near));
 }

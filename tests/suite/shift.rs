@@ -525,7 +525,8 @@ struct Causes {
 #[test]
 fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
     use restir_pt::bsdf::{bsdf_eval_pdf, lobe_weights};
-    use restir_pt::bvh::{offset_ray_origin, trace_occluded};
+    use restir_pt::bvh::trace_occluded;
+    use restir_pt::ray_offset::offset_ray_origin;
     let mut total = Causes::default();
     let mut diverged = 0;
     for name in ["mirror", "glass", "near-field", "cornell", "veach-door"] {
@@ -552,8 +553,8 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
                 let d = x2.pos - y1.pos;
                 let dir = d.normalize();
                 let facing = |n: Vec3, v: Vec3| if v.dot(n) > 0.0 { n } else { -n };
-                let origin = offset_ray_origin(y1.pos, facing(y1.normal, dir));
-                let target = offset_ray_origin(x2.pos, facing(x2.normal, -dir));
+                let origin = offset_ray_origin(y1.pos, facing(y1.normal, dir), &scene.triangles[y1.triangle as usize]);
+                let target = offset_ray_origin(x2.pos, facing(x2.normal, -dir), &scene.triangles[x2.triangle as usize]);
                 let wo = (camera - y1.pos).normalize();
                 let (f, _) = bsdf_eval_pdf(&material(&y1), y1.normal, wo, dir);
                 if is_delta(&y1) || is_delta(&x1) || is_delta(&x2) {
