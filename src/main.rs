@@ -269,7 +269,7 @@ struct ReferenceCmd {
 #[derive(Args)]
 struct ProfileCmd {
     scene: Option<PathBuf>,
-    /// Frames to time after two warm-up frames (static camera).
+    /// Frames to time (a static camera unless --camera-path); kernels are compiled before them.
     #[arg(long, default_value_t = 16)]
     frames: u32,
     #[arg(long, default_value_t = 256)]
@@ -280,6 +280,10 @@ struct ProfileCmd {
     max_depth: u32,
     #[arg(long, default_value_t = 0)]
     camera: usize,
+    /// Move the camera along the scene's camera path from --camera instead of accumulating
+    /// frames of an unmoved one.
+    #[arg(long)]
+    camera_path: bool,
     #[command(flatten)]
     restir: RestirOpts,
     /// Folder for passes.csv, trace.json and passes.svg.
@@ -425,6 +429,7 @@ fn main() -> ExitCode {
             height: p.height,
             max_depth: p.max_depth,
             camera: p.camera,
+            camera_path: p.camera_path,
             out_dir: p.out_dir,
             device: p.device.into(),
         }),

@@ -9,6 +9,7 @@ use anyhow::{bail, Context as _, Result};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::metrics::quantile;
 use crate::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
+use crate::scene::camera_on_path;
 
 pub struct ProfileArgs {
     pub scene: Option<PathBuf>,
@@ -17,6 +18,9 @@ pub struct ProfileArgs {
     pub height: u32,
     pub max_depth: u32,
     pub camera: usize,
+    /// Frames move along the scene's camera path from `camera` (`camera_on_path`); otherwise
+    /// they are accumulated from `camera`.
+    pub camera_path: bool,
     pub restir: RestirSettings,
     pub out_dir: PathBuf,
     pub device: DeviceArgs,
@@ -111,16 +115,17 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
     if !ctx.info.timestamps_supported {
         bail!("{}: the device has no compute timestamps to profile with", ctx.info.name);
     }
-    let mut renderer = Restir::new(&ctx, &scene, &settings, &args.restir)?;
-    // llvmpipe compiles a pipeline at its first dispatch: two unrecorded warm-up frames (the
-    // first has no temporal pass).
-    for _ in 0..2 {
-        renderer.frame(&scene, args.camera, true)?;
-    }
-    renderer.reset(settings.seed)?;
+    let spinner = super::render::compile_progress();
+    let mut renderer = Restir::with_progress(&ctx, &scene, &settings, &args.restir, &|name| spinner.set_message(name.to_string()))?;
+    spinner.finish_and_clear();
+    super::render::print_compile_summary(&renderer.compile_reports());
     let mut times = vec![];
-    for _ in 0..args.frames {
-        let stats = renderer.frame(&scene, args.camera, true)?;
+    for f in 0..args.frames {
+        let stats = if args.camera_path {
+            renderer.frame(&scene, camera_on_path(args.camera, f, scene.cameras.len()), false)?
+        } else {
+            renderer.frame(&scene, args.camera, true)?
+        };
         times.push(stats.pass_ms.expect("timestamps are supported"));
     }
     drop(renderer);
@@ -132,8 +137,9 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
             let _ = writeln!(csv, "{f},{},{ms:.4}", PASS_NAMES[p]);
         }
     }
+    let motion = if args.camera_path { "moving camera" } else { "static camera" };
     let title = format!(
-        "{} {} {}x{} on {}",
+        "{} {} {}x{}, {motion}, on {}",
         path.display(),
         args.restir.label(),
         args.width,
