@@ -166,9 +166,8 @@ bool needs_targets_from(uint i) {
 // Step (i, l) of the n x n steps makes at most one shift: for l = 0 the shift of input i's
 // sample into the canonical domain, y_i = T_i(X_i); for l >= 1 (l != i) the inverse shift of y_i
 // into domain l, for p̂_{<-l}(y_i). Every shift goes through the one call below: a kernel
-// inlines each call site whole, and with a call per use the reuse kernels took llvmpipe 10 s
-// each to compile and overflowed its cache of compiled kernels, which then compiled them again
-// every frame.
+// inlines each call site whole, and llvmpipe's compile time grows with the copies
+// (docs/lab-notebook.md, "Compile time of the reuse kernels").
 Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
     Resampler s = resampler_begin();
     PathRecord y = reservoir_empty().record;

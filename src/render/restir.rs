@@ -18,6 +18,11 @@ use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, K
 
 const LOCAL_SIZE: u32 = 8;
 
+/// Shared memory of one workgroup of the ReSTIR kernels: the path being built by each of its
+/// LOCAL_SIZE² invocations (glsl/shift.glsl, `path_vertices`, `path_lobes`, `path_weights`),
+/// per vertex a 32-byte vertex, a lobe and a 16-byte weight row.
+const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
+
 /// GPU milliseconds per pass of one frame (indexed like PASS_NAMES); None without timestamps.
 #[derive(Debug, Clone)]
 pub struct FrameStats {
@@ -94,6 +99,13 @@ impl Restir {
     ) -> Result<Self> {
         settings.validate(scene)?;
         restir.validate(settings.max_depth)?;
+        if ctx.info.max_compute_shared_memory < SHARED_BYTES {
+            anyhow::bail!(
+                "{}: ReSTIR PT's kernels need {SHARED_BYTES} bytes of shared memory per workgroup, the device offers {}",
+                ctx.info.name,
+                ctx.info.max_compute_shared_memory
+            );
+        }
         let pixels = settings.pixel_count() as u64;
         ctx.check_binding_size("the accumulation image", pixels * 16)?;
         let surface_bytes = pixels * std::mem::size_of::<Surface>() as u64;

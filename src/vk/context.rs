@@ -31,6 +31,8 @@ pub struct DeviceInfo {
     pub device_type: vk::PhysicalDeviceType,
     pub max_storage_buffer_range: u64,
     pub max_uniform_buffer_range: u64,
+    /// Bytes of shared memory a compute workgroup may use (Vulkan's floor: 16384).
+    pub max_compute_shared_memory: u32,
     pub timestamp_period_ns: f32,
     pub timestamps_supported: bool,
     /// Iterations each loop of one shader invocation may run in total before the driver silently
@@ -408,6 +410,7 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
         device_type: props.device_type,
         max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
         max_uniform_buffer_range: props.limits.max_uniform_buffer_range as u64,
+        max_compute_shared_memory: props.limits.max_compute_shared_memory_size,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamps_supported: timestamp_bits > 0 && props.limits.timestamp_compute_and_graphics == vk::TRUE,
         loop_iteration_limit: device_name(&props).contains("llvmpipe").then_some(LLVMPIPE_LOOP_LIMIT),
