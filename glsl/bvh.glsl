@@ -3,6 +3,7 @@
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
+#include "counters.glsl"
 #include "loop_budget.glsl"
 #include "types.glsl"
 
@@ -61,8 +62,11 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     vec3 o_inv_d = o * inv_d;
     uint end = nodes.length();
     uint node = 0u;
+    count_lane(COUNTER_TRAVERSALS);
     while (node < end) {
         loop_tick();
+        count_lane(COUNTER_NODE_VISITS);
+        count_subgroup(COUNTER_NODE_ITERATIONS);
         BvhNode n = nodes[node];
         if (!intersect_aabb(o_inv_d, inv_d, n.lo, n.hi, hit.t)) {
             node = n.skip;
@@ -77,6 +81,8 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
         uint i = first;
         for (; i < last; ++i) {
             loop_tick();
+            count_lane(COUNTER_TRIANGLE_TESTS);
+            count_subgroup(COUNTER_TRIANGLE_ITERATIONS);
             float t;
             vec2 bary;
             if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)) {
@@ -116,14 +122,22 @@ vec3 offset_ray_origin(vec3 p, vec3 n) {
 // Segment tests stop this fraction short of their (offset) end point.
 const float SEGMENT_EPSILON = 1e-4;
 
+// The ray segment_occluded traces between surface points p (normal np) and q (normal nq): it
+// runs from `origin` over `dir` (unnormalised; the segment ends at tmax = 1 - SEGMENT_EPSILON).
+void segment_ray(vec3 p, vec3 np, vec3 q, vec3 nq, out vec3 origin, out vec3 dir) {
+    vec3 d = q - p;
+    origin = offset_ray_origin(p, dot(d, np) > 0.0 ? np : -np);
+    vec3 target = offset_ray_origin(q, dot(d, nq) < 0.0 ? nq : -nq);
+    dir = target - origin;
+}
+
 // Whether anything blocks the segment between surface points p (normal np) and q (normal nq).
 // Both ends are offset off their surfaces, each towards the other, and the ray runs between the
 // offset points: offsetting one end only moves a grazing far hit by more than any epsilon.
 bool segment_occluded(vec3 p, vec3 np, vec3 q, vec3 nq) {
-    vec3 d = q - p;
-    vec3 origin = offset_ray_origin(p, dot(d, np) > 0.0 ? np : -np);
-    vec3 target = offset_ray_origin(q, dot(d, nq) < 0.0 ? nq : -nq);
-    return trace_occluded(origin, target - origin, 1.0 - SEGMENT_EPSILON);
+    vec3 origin, dir;
+    segment_ray(p, np, q, nq, origin, dir);
+    return trace_occluded(origin, dir, 1.0 - SEGMENT_EPSILON);
 }
 
 #endif

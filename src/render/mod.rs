@@ -1,5 +1,6 @@
 //! Rendering on the GPU: scene upload, settings, the path tracer, ReSTIR PT and their images.
 
+mod counters;
 mod image;
 mod path_tracer;
 mod reservoir_layers;
@@ -8,6 +9,7 @@ mod restir_settings;
 mod scene_gpu;
 mod settings;
 
+pub use counters::TraversalCounters;
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir, PASS_NAMES};
