@@ -3,6 +3,7 @@
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
+#include "counters.glsl"
 #include "loop_budget.glsl"
 #include "ray_offset.glsl"
 #include "types.glsl"
@@ -62,8 +63,11 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     vec3 o_inv_d = o * inv_d;
     uint end = nodes.length();
     uint node = 0u;
+    count_lane(COUNTER_TRAVERSALS);
     while (node < end) {
         loop_tick();
+        count_lane(COUNTER_NODE_VISITS);
+        count_subgroup(COUNTER_NODE_ITERATIONS);
         BvhNode n = nodes[node];
         if (!intersect_aabb(o_inv_d, inv_d, n.lo, n.hi, hit.t)) {
             node = n.skip;
@@ -78,6 +82,8 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
         uint i = first;
         for (; i < last; ++i) {
             loop_tick();
+            count_lane(COUNTER_TRIANGLE_TESTS);
+            count_subgroup(COUNTER_TRIANGLE_ITERATIONS);
             float t;
             vec2 bary;
             if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)) {

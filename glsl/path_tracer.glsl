@@ -1,6 +1,8 @@
 // Unidirectional path tracing with NEE and BSDF sampling combined by the power heuristic, written
 // as a per-segment state machine: a kernel steps every lane once per iteration and restarts lanes
 // whose path ended, so SIMD lanes (lavapipe runs 8 in lockstep) stay busy however long paths are.
+// Each step traces one pair of rays in one traversal (trace_pair.glsl): the next segment and the
+// shadow ray of the vertex before it, whose NEE contribution waits in the state until then.
 // max_depth counts path segments: 1 shows emitters seen directly, 2 adds direct lighting.
 #ifndef PATH_TRACER_GLSL
 #define PATH_TRACER_GLSL
@@ -10,18 +12,22 @@
 #include "camera.glsl"
 #include "lights.glsl"
 #include "rng.glsl"
+#include "trace_pair.glsl"
 
 const float RAY_TMAX = 1e30;
 const float RR_MAX_SURVIVAL = 0.95;
 const uint RR_START_DEPTH = 3u;
 
 
-// Whether the light sample is hidden from the shading point x (geometric normal ng, on triangle
-// index tri).
-bool shadow_ray_occluded(vec3 x, vec3 ng, uint tri, LightSample ls) {
-    if (ls.triangle == NO_EMITTER) return trace_occluded(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng, triangles[tri]), ls.dir, RAY_TMAX);
+// The ray that tells whether the light sample is hidden from the shading point x (geometric
+// normal ng, on triangle index tri): towards the environment, or the segment to the sampled
+// emitter point.
+PairRay shadow_ray(vec3 x, vec3 ng, uint tri, LightSample ls) {
+    if (ls.triangle == NO_EMITTER) return PairRay(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng, triangles[tri]), ls.dir, RAY_TMAX);
     Triangle light = triangles[ls.triangle];
-    return segment_occluded(x, ng, tri, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)), ls.triangle);
+    PairRay r;
+    segment_ray(x, ng, tri, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)), ls.triangle, r.origin, r.dir, r.tmax);
+    return r;
 }
 
 struct PathState {
@@ -33,6 +39,9 @@ struct PathState {
     bool prev_delta;  // the last scattering was a delta lobe (or the camera): no MIS
     uint depth;       // segments traced so far
     uint seed;
+    bool extend;      // the next segment (origin, dir) is still to be traced
+    PairRay shadow;   // the pending shadow ray; tmax 0 when there is none
+    vec3 nee;         // radiance the pending shadow ray adds if it reaches the light
 };
 
 PathState path_begin(uvec2 pixel, uint seed) {
@@ -46,13 +55,22 @@ PathState path_begin(uvec2 pixel, uint seed) {
     s.prev_delta = true;
     s.depth = 0u;
     s.seed = seed;
+    s.extend = true;
+    s.shadow = PairRay(vec3(0.0), vec3(0.0, 0.0, 1.0), 0.0);
+    s.nee = vec3(0.0);
     return s;
 }
 
-// Traces one segment and scatters at its end; returns false once the path has ended.
+// Traces the pending shadow ray and the next segment, and scatters at the segment's end; returns
+// false once the path has ended.
 bool path_step(inout PathState s) {
+    Hit hit;
+    bool occluded;
+    trace_pair(PairRay(s.origin, s.dir, s.extend ? RAY_TMAX : 0.0), s.shadow, hit, occluded);
+    if (s.shadow.tmax > 0.0 && !occluded) s.radiance += s.nee;
+    s.shadow.tmax = 0.0;
+    if (!s.extend) return false;
     s.depth += 1u;
-    Hit hit = trace_closest(s.origin, s.dir, RAY_TMAX);
     if (hit.triangle == NO_HIT) {
         if (SCENE_ENVIRONMENT != 0 && max_component(scene_env.rgb) > 0.0) {
             float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, environment_pdf());
@@ -78,22 +96,24 @@ bool path_step(inout PathState s) {
         float bsdf_pdf;
         vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
-            if (!shadow_ray_occluded(x, ng, hit.triangle, ls)) {
-                s.radiance += s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
-            }
+            s.shadow = shadow_ray(x, ng, hit.triangle, ls);
+            s.nee = s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
         }
     }
 
+    // A path that ends here still traces its pending shadow ray in one more step.
+    s.extend = false;
     BsdfSample bs = bsdf_sample(m, ng, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
-    if (bs.lobe == LOBE_NONE) return false;
+    if (bs.lobe == LOBE_NONE) return s.shadow.tmax > 0.0;
     s.beta *= bs.weight;
     s.prev_pdf = bs.pdf;
     s.prev_delta = (bs.lobe & LOBE_DELTA) != 0u;
     if ((flags & FLAG_RUSSIAN_ROULETTE) != 0u && s.depth >= RR_START_DEPTH) {
         float survive = min(max_component(s.beta), RR_MAX_SURVIVAL);
-        if (ul.w >= survive) return false;
+        if (ul.w >= survive) return s.shadow.tmax > 0.0;
         s.beta /= survive;
     }
+    s.extend = true;
     s.origin = offset_ray_origin(x, dot(bs.wi, ng) > 0.0 ? ng : -ng, tri);
     s.dir = bs.wi;
     return true;

@@ -13,8 +13,16 @@ layout(std430, set = 0, binding = 6) buffer AccumSq { vec4 accum_sq[]; };  // rg
 layout(std430, set = 0, binding = 7) buffer Status {
     uint max_loop_iterations;
     uint loop_budget_cut_groups;
-    uint nonfinite_paths;        // paths whose radiance or throughput is NaN or infinite
+    uint nonfinite_paths;           // paths whose radiance or throughput is NaN or infinite
+    uvec2 counters[COUNTER_COUNT];  // 64-bit totals (low, high) of counters.glsl
+    uint subgroup_lanes;
 };
+
+// Adds a subgroup's counter total to its 64-bit sum; call from the elected lane.
+void add_counter(uint counter, uint value) {
+    uint before = atomicAdd(counters[counter].x, value);
+    if (before + value < before) atomicAdd(counters[counter].y, 1u);
+}
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
@@ -28,6 +36,8 @@ void main() {
     PathState path = path_begin(p, path_seed(pixel, sample_offset, render_seed));
     while (inside) {
         loop_tick();
+        count_lane(COUNTER_PATH_STEPS);
+        count_subgroup(COUNTER_STEP_ITERATIONS);
         if (path_step(path)) continue;
         if (any(isnan(path.radiance)) || any(isinf(path.radiance)) || any(isnan(path.beta)) || any(isinf(path.beta))) nonfinite += 1u;
         sum += path.radiance;
@@ -44,9 +54,15 @@ void main() {
     uint iterations = subgroup_loop_iterations();
     bool cut = subgroup_loop_budget_cut();
     uint group_nonfinite = subgroupAdd(nonfinite);
+    uint counts[COUNTER_COUNT];
+    for (uint c = 0u; c < COUNTER_COUNT; ++c) counts[c] = subgroup_count(c);
     if (subgroupElect()) {
         atomicMax(max_loop_iterations, iterations);
         if (cut) atomicAdd(loop_budget_cut_groups, 1u);
         if (group_nonfinite > 0u) atomicAdd(nonfinite_paths, group_nonfinite);
+        if (TRAVERSAL_COUNTERS != 0) {
+            for (uint c = 0u; c < COUNTER_COUNT; ++c) add_counter(c, counts[c]);
+            atomicMax(subgroup_lanes, gl_SubgroupSize);
+        }
     }
 }

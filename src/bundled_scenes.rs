@@ -356,3 +356,15 @@ pub fn furnace() -> String {
     camera_path(&mut b, Vec3::new(0.0, 0.5, 4.0), Vec3::ZERO, Vec3::new(0.05, 0.0, 0.0), 0.9);
     b.finish("furnace", Vec3::ONE)
 }
+
+/// The Cornell box with a diffuse sphere of `2 * segments * (rings - 1)` triangles floating in it:
+/// the scenes of the throughput-against-scene-size benchmark (tools/make_scaling_scenes.rs).
+pub fn cornell_sphere(rings: u32, segments: u32) -> String {
+    let mut b = GltfBuilder::default();
+    cornell_room(&mut b, CORNELL_LIGHT, CORNELL_LIGHT_SIZE);
+    let white = b.material("box white", MaterialSpec::diffuse(WHITE));
+    cornell_boxes(&mut b, white, white);
+    add(&mut b, "sphere", &MeshData::sphere(Vec3::new(0.0, 0.3, 0.25), 0.3, rings, segments), white);
+    cornell_camera_path(&mut b);
+    b.finish("cornell-sphere", Vec3::ZERO)
+}

@@ -283,8 +283,82 @@ pub const SEGMENT_EPSILON: f32 = 1e-4;
 /// hit by more than any epsilon.
 #[allow(clippy::too_many_arguments)]
 pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: Vec3, tp: u32, q: Vec3, nq: Vec3, tq: u32) -> bool {
+    let (origin, dir) = segment_ray(triangles, p, np, tp, q, nq, tq);
+    trace_occluded(nodes, triangles, origin, dir, 1.0 - SEGMENT_EPSILON)
+}
+
+/// A ray of `trace_pair`; `tmax <= 0` makes it inactive (no hit, no node visit of its own).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairRay {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub tmax: f32,
+}
+
+/// Scenes up to this many triangles, when bound as uniform buffers, trace pairs by testing every
+/// triangle (`SCENE_BRUTE_FORCE`): on llvmpipe that beats the BVH, whose node loads and nested
+/// loops cost more than the triangle tests they save (docs/performance.md).
+pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 64;
+
+/// Twin of GLSL `trace_pair` (glsl/trace_pair.glsl): the closest hit of `closest` and whether
+/// anything blocks `shadow`, in one traversal of the BVH (or, with `brute_force`, one pass over
+/// every triangle in index order, the closest hit being the first of equal distances). The BVH
+/// form tests each ray against the same triangles in the same order as `bvh_traverse`, so its
+/// results equal `trace_closest` and `trace_occluded` bit for bit.
+pub fn trace_pair(nodes: &[BvhNode], triangles: &[Triangle], brute_force: bool, closest: PairRay, shadow: PairRay) -> (Hit, bool) {
+    let mut hit = Hit {
+        t: closest.tmax,
+        triangle: NO_HIT,
+        bary: Vec2::ZERO,
+    };
+    let mut occluded = false;
+    let test = |i: usize, enter_c: bool, enter_s: bool, hit: &mut Hit, occluded: &mut bool| {
+        let tri = &triangles[i];
+        if enter_c {
+            if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, hit.t) {
+                *hit = Hit { t, triangle: i as u32, bary };
+            }
+        }
+        *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some();
+    };
+    if brute_force {
+        for i in 0..triangles.len() {
+            test(i, true, true, &mut hit, &mut occluded);
+        }
+        return (hit, occluded);
+    }
+    let (active_c, active_s) = (closest.tmax > 0.0, shadow.tmax > 0.0);
+    let (inv_c, inv_s) = (safe_inverse(closest.dir), safe_inverse(shadow.dir));
+    let (o_inv_c, o_inv_s) = (closest.origin * inv_c, shadow.origin * inv_s);
+    let mut node = if active_c || active_s { 0 } else { nodes.len() };
+    while node < nodes.len() {
+        let n = &nodes[node];
+        let (lo, hi) = (Vec3::from(n.lo), Vec3::from(n.hi));
+        let enter_c = active_c && intersect_aabb(o_inv_c, inv_c, lo, hi, hit.t);
+        let enter_s = active_s && !occluded && intersect_aabb(o_inv_s, inv_s, lo, hi, shadow.tmax);
+        if !enter_c && !enter_s {
+            node = n.skip as usize;
+            continue;
+        }
+        let (first, count) = n.leaf_range();
+        if count == 0 {
+            node += 1;
+            continue;
+        }
+        for i in first..first + count {
+            test(i as usize, enter_c, enter_s, &mut hit, &mut occluded);
+        }
+        node = if occluded && !active_c { nodes.len() } else { n.skip as usize };
+    }
+    (hit, occluded)
+}
+
+/// Twin of GLSL `segment_ray`: the ray `segment_occluded` traces from p (normal np, on triangle
+/// index tp) to q (normal nq, on triangle index tq), as (origin, unnormalised direction); the
+/// segment ends at tmax = 1 - SEGMENT_EPSILON.
+pub fn segment_ray(triangles: &[Triangle], p: Vec3, np: Vec3, tp: u32, q: Vec3, nq: Vec3, tq: u32) -> (Vec3, Vec3) {
     let d = q - p;
     let origin = offset_ray_origin(p, if d.dot(np) > 0.0 { np } else { -np }, &triangles[tp as usize]);
     let target = offset_ray_origin(q, if d.dot(nq) < 0.0 { nq } else { -nq }, &triangles[tq as usize]);
-    trace_occluded(nodes, triangles, origin, target - origin, 1.0 - SEGMENT_EPSILON)
+    (origin, target - origin)
 }

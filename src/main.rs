@@ -235,6 +235,11 @@ struct BenchCmd {
     /// Timed runs after one warm-up run.
     #[arg(long, default_value_t = 5)]
     runs: u32,
+    /// Count rays, BVH node visits, triangle tests and SIMD lane use in the kernel (slower:
+    /// a profile, not a timing).
+    #[arg(long)]
+    counters: bool,
+    /// Write the figures as JSON to this file.
     #[arg(long)]
     report: Option<PathBuf>,
     #[command(flatten)]
@@ -472,6 +477,7 @@ fn main() -> ExitCode {
             max_depth: b.max_depth,
             runs: b.runs,
             russian_roulette: b.russian_roulette.on(),
+            counters: b.counters,
             report: b.report,
             device: b.device.into(),
         }),

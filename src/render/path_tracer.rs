@@ -6,7 +6,9 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 
+use super::counters::{TraversalCounters, COUNTER_COUNT};
 use super::{Image, RenderSettings, SceneGpu};
+use crate::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::error::GpuError;
 use crate::scene::Scene;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
@@ -21,8 +23,9 @@ const MAX_CHUNK_GROWTH: u32 = 8;
 /// pixels whose paths cost more than the ones measured so far.
 const LOOP_BUDGET_SHARE: f64 = 0.25;
 /// Words of glsl/pathtrace.comp's Status block: max loop iterations, subgroups with a cut loop,
-/// paths with a non-finite radiance or throughput.
-const STATUS_WORDS: u64 = 3;
+/// paths with a non-finite radiance or throughput, the 64-bit profile counters and the subgroup
+/// size.
+const STATUS_WORDS: u64 = 4 + 2 * COUNTER_COUNT as u64;
 const LOCAL_SIZE: u32 = 8;
 
 pub struct RenderStats {
@@ -34,6 +37,8 @@ pub struct RenderStats {
     pub nonfinite_paths: u64,
     /// True if the render stopped early on request (Ctrl-C); the image holds what was done.
     pub interrupted: bool,
+    /// The kernel's profile counters, when built with them (`PathTracer::with_counters`).
+    pub counters: Option<TraversalCounters>,
 }
 
 impl RenderStats {
@@ -55,10 +60,17 @@ pub struct PathTracer {
     settings: RenderSettings,
     base_params: crate::gpu_types::FrameParams,
     samples_done: u32,
+    counters: Option<TraversalCounters>,
 }
 
 impl PathTracer {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
+        Self::with_counters(ctx, scene, settings, false)
+    }
+
+    /// Like `new`; with `counters` the kernel also counts rays, node visits, triangle tests and
+    /// SIMD loop iterations (glsl/counters.glsl), which `render` returns in its stats.
+    pub fn with_counters(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, counters: bool) -> Result<Self> {
         settings.validate(scene)?;
         let pixels = settings.pixel_count() as u64;
         ctx.check_binding_size("the accumulation image", pixels * 16)?;
@@ -74,7 +86,14 @@ impl PathTracer {
         let status = Buffer::new(ctx, "dispatch status", STATUS_WORDS * 4, BufferUsage::Storage)?;
         let mut bindings = scene_gpu.bindings();
         bindings.extend([Binding::Storage, Binding::Storage, Binding::Storage]);
-        let mut kernel = Kernel::new(ctx, "pathtrace.comp", &scene_gpu.defines(), &bindings, 0)?;
+        let mut defines = scene_gpu.defines();
+        if scene_gpu.uniform && scene.triangles.len() <= BRUTE_FORCE_MAX_TRIANGLES {
+            defines.push(("SCENE_BRUTE_FORCE", "1"));
+        }
+        if counters {
+            defines.push(("TRAVERSAL_COUNTERS", "1"));
+        }
+        let mut kernel = Kernel::new(ctx, "pathtrace.comp", &defines, &bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
         buffers.extend([&accum, &accum_sq, &status]);
         kernel.bind(&buffers);
@@ -97,6 +116,7 @@ impl PathTracer {
             settings: settings.clone(),
             _scene_gpu: scene_gpu,
             samples_done: 0,
+            counters: counters.then(TraversalCounters::default),
         })
     }
 
@@ -118,6 +138,9 @@ impl PathTracer {
         self.base_params = settings.frame_params(scene);
         self.settings = settings.clone();
         self.samples_done = 0;
+        if let Some(c) = self.counters.as_mut() {
+            *c = TraversalCounters::default();
+        }
         Ok(())
     }
 
@@ -156,6 +179,10 @@ impl PathTracer {
             .into());
         }
         self.samples_done += samples;
+        if let Some(c) = self.counters.as_mut() {
+            let words = &status[3..];
+            c.add(&TraversalCounters::from_words(words, words[2 * COUNTER_COUNT]));
+        }
         Ok((self.timer.read_ms(1)?.map(|t| t[0]), iterations, nonfinite))
     }
 
@@ -206,6 +233,7 @@ impl PathTracer {
             wall_ms: start.elapsed().as_secs_f64() * 1e3,
             nonfinite_paths,
             interrupted,
+            counters: self.counters,
         })
     }
 

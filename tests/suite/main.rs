@@ -3,6 +3,7 @@
 
 mod common;
 
+mod bench_cli;
 mod bsdf_oracle;
 mod bvh_oracle;
 mod cli;
@@ -21,3 +22,4 @@ mod scene_loader;
 mod scenes;
 mod shift;
 mod speed_accuracy;
+mod trace_pair_oracle;

@@ -1,0 +1,53 @@
+// Profile counters of a kernel compiled with TRAVERSAL_COUNTERS=1 (`restir-pt bench --counters`):
+// per invocation ("lane") how many traversals (one ray or one pair of rays), BVH node visits, triangle tests and path steps it ran,
+// and per subgroup (one llvmpipe SIMD group of lanes in lockstep) how many iterations the node,
+// triangle and path loops took, counted once by the elected lane. A lane idles in an iteration
+// its subgroup runs without it, so lane counts over (subgroup iterations * subgroup size) are
+// the share of SIMD lanes doing work. Twin of the host's TraversalCounters (src/render/counters.rs).
+#ifndef COUNTERS_GLSL
+#define COUNTERS_GLSL
+
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
+#ifndef TRAVERSAL_COUNTERS
+#define TRAVERSAL_COUNTERS 0
+#endif
+
+const uint COUNTER_TRAVERSALS = 0u;
+const uint COUNTER_NODE_VISITS = 1u;
+const uint COUNTER_TRIANGLE_TESTS = 2u;
+const uint COUNTER_PATH_STEPS = 3u;
+const uint COUNTER_NODE_ITERATIONS = 4u;
+const uint COUNTER_TRIANGLE_ITERATIONS = 5u;
+const uint COUNTER_STEP_ITERATIONS = 6u;
+const uint COUNTER_COUNT = 7u;
+
+#if TRAVERSAL_COUNTERS
+uint profile_counts[COUNTER_COUNT] = uint[COUNTER_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u);
+#endif
+
+// Counts one event of this lane.
+void count_lane(uint counter) {
+#if TRAVERSAL_COUNTERS
+    profile_counts[counter] += 1u;
+#endif
+}
+
+// Counts one iteration of the enclosing loop for the subgroup, once, whichever lanes are active.
+void count_subgroup(uint counter) {
+#if TRAVERSAL_COUNTERS
+    if (subgroupElect()) profile_counts[counter] += 1u;
+#endif
+}
+
+// The subgroup's total of a counter; call from uniform control flow.
+uint subgroup_count(uint counter) {
+#if TRAVERSAL_COUNTERS
+    return subgroupAdd(profile_counts[counter]);
+#else
+    return 0u;
+#endif
+}
+
+#endif

@@ -1,0 +1,143 @@
+//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (src/bvh.rs), in
+//! both forms: the BVH traversed once for a closest-hit and a shadow ray, and the brute-force
+//! pass of small uniform-buffer scenes; and the twin against `trace_closest`/`trace_occluded`.
+
+use std::sync::Arc;
+
+use glam::{Vec3, Vec4};
+use restir_pt::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
+use restir_pt::render::{RenderSettings, SceneGpu};
+use restir_pt::scene::{load_scene, Scene};
+use restir_pt::vk::{Buffer, BufferUsage, Context, Kernel};
+
+use crate::bvh_oracle::random_scene;
+use crate::common::{assert_clean, close, gpu, TestRng};
+
+const PAIRS: usize = 12_000;
+
+/// Random pairs inside `extent` (a cube of that half-size): closest rays from random points, and
+/// shadow rays that are segments between two random points, a tenth of either kind inactive.
+fn random_pairs(seed: u64, extent: f32) -> Vec<(PairRay, PairRay)> {
+    let mut r = TestRng(seed);
+    let point = |r: &mut TestRng| (Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 2.0 - 1.0) * extent;
+    (0..PAIRS)
+        .map(|i| {
+            let closest = PairRay {
+                origin: point(&mut r),
+                dir: r.unit_vector(),
+                tmax: if i % 10 == 3 { 0.0 } else { 1e30 },
+            };
+            let (p, q) = (point(&mut r), point(&mut r));
+            let (origin, dir) = (p, q - p);
+            let shadow = PairRay {
+                origin,
+                dir,
+                tmax: if i % 10 == 7 { 0.0 } else { 1.0 - SEGMENT_EPSILON },
+            };
+            (closest, shadow)
+        })
+        .collect()
+}
+
+fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairRay, PairRay)]) -> Vec<(Hit, bool)> {
+    let scene_gpu = SceneGpu::upload(ctx, scene).unwrap();
+    let params = Buffer::new(
+        ctx,
+        "params",
+        std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
+        BufferUsage::Params,
+    )
+    .unwrap();
+    params.write(&[RenderSettings::default().frame_params(scene)]).unwrap();
+    let inputs: Vec<Vec4> = pairs
+        .iter()
+        .flat_map(|(c, s)| [c.origin.extend(c.tmax), c.dir.extend(0.0), s.origin.extend(s.tmax), s.dir.extend(0.0)])
+        .collect();
+    let input = Buffer::from_slice(ctx, "pairs", &inputs).unwrap();
+    let output = Buffer::new(ctx, "hits", pairs.len() as u64 * 32, BufferUsage::Storage).unwrap();
+    let mut defines = scene_gpu.defines();
+    defines.push(("SCENE_BRUTE_FORCE", if brute_force { "1" } else { "0" }));
+    let mut kinds = scene_gpu.bindings();
+    kinds.extend([restir_pt::vk::Binding::Storage, restir_pt::vk::Binding::Storage]);
+    let kernel = Kernel::new(ctx, "oracle/trace_pair_oracle.comp", &defines, &kinds, 4).unwrap();
+    let mut buffers = scene_gpu.buffers(&params);
+    buffers.extend([&input, &output]);
+    kernel.bind(&buffers);
+    let count = pairs.len() as u32;
+    kernel.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
+    let out = output.read::<Vec4>(2 * pairs.len()).unwrap();
+    out.chunks(2)
+        .map(|o| {
+            let hit = Hit {
+                t: o[0].x,
+                triangle: o[0].y.to_bits(),
+                bary: glam::Vec2::new(o[0].z, o[0].w),
+            };
+            (hit, o[1].x == 1.0)
+        })
+        .collect()
+}
+
+/// GPU against twin for every pair; returns how many closest rays hit.
+fn assert_gpu_matches_twin(scene: &Scene, gpu_hits: &[(Hit, bool)], pairs: &[(PairRay, PairRay)], brute_force: bool) -> usize {
+    let mut hits = 0;
+    for (i, ((g, g_occluded), (c, s))) in gpu_hits.iter().zip(pairs).enumerate() {
+        let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, brute_force, *c, *s);
+        assert_eq!(g.triangle, h.triangle, "pair {i}: GLSL t {} vs Rust t {}", g.t, h.t);
+        assert_eq!(*g_occluded, occluded, "pair {i}: occlusion");
+        if h.triangle != NO_HIT {
+            hits += 1;
+            assert!(close(g.t, h.t, 1e-5), "pair {i}: t {} vs {}", g.t, h.t);
+            assert!((g.bary - h.bary).abs().max_element() < 1e-5, "pair {i}: barycentrics");
+        }
+    }
+    hits
+}
+
+#[test]
+fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
+    let ctx = gpu();
+    let big = random_scene(5);
+    let pairs = random_pairs(6, 6.0);
+    let gpu_hits = run_gpu(&ctx, &big, false, &pairs);
+    let hits = assert_gpu_matches_twin(&big, &gpu_hits, &pairs, false);
+    assert!(hits > PAIRS / 4, "only {hits} of {PAIRS} closest rays hit");
+    let occluded = gpu_hits.iter().filter(|g| g.1).count();
+    assert!(occluded > PAIRS / 10 && occluded < PAIRS * 9 / 10, "{occluded} of {PAIRS} shadow rays occluded");
+
+    // The Cornell box is small enough for uniform buffers on lavapipe: both forms there.
+    let cornell = load_scene(&restir_pt::cli::bundled_file("scenes/cornell.gltf".as_ref())).unwrap();
+    let pairs = random_pairs(7, 0.99);
+    for brute_force in [false, true] {
+        let gpu_hits = run_gpu(&ctx, &cornell, brute_force, &pairs);
+        let hits = assert_gpu_matches_twin(&cornell, &gpu_hits, &pairs, brute_force);
+        assert!(hits > PAIRS * 6 / 10, "only {hits} of {PAIRS} closest rays hit the box");
+    }
+    assert_clean(&ctx);
+}
+
+#[test]
+fn trace_pair_twin_equals_single_ray_traversals() {
+    for (scene, extent) in [(random_scene(3), 6.0), (random_scene(11), 2.0)] {
+        let (mut ties, mut hits) = (0, 0);
+        for (i, (c, s)) in random_pairs(12, extent).into_iter().enumerate() {
+            let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, false, c, s);
+            let (b, b_occluded) = trace_pair(&scene.nodes, &scene.triangles, true, c, s);
+            if c.tmax > 0.0 {
+                let single = trace_closest(&scene.nodes, &scene.triangles, c.origin, c.dir, c.tmax);
+                assert_eq!((h.triangle, h.t.to_bits()), (single.triangle, single.t.to_bits()), "pair {i}: closest");
+            } else {
+                assert_eq!(h.triangle, NO_HIT, "pair {i}: an inactive ray hit");
+            }
+            let single = s.tmax > 0.0 && trace_occluded(&scene.nodes, &scene.triangles, s.origin, s.dir, s.tmax);
+            assert_eq!(occluded, single, "pair {i}: occlusion");
+            assert_eq!(b_occluded, single, "pair {i}: brute-force occlusion");
+            // Brute force keeps the first of equal distances in index order, the BVH the first it
+            // meets: only exact ties may name another triangle.
+            assert_eq!(b.t.to_bits(), h.t.to_bits(), "pair {i}: brute-force distance");
+            hits += (h.triangle != NO_HIT) as usize;
+            ties += (b.triangle != h.triangle) as usize;
+        }
+        assert!(hits > PAIRS / 4 && ties * 1000 <= hits, "{ties} ties in {hits} hits");
+    }
+}
