@@ -15,11 +15,12 @@ use crate::common::{assert_clean, close, gpu, TestRng};
 
 const PAIRS: usize = 12_000;
 
-/// Random pairs inside `extent` (a cube of that half-size): closest rays from random points, and
-/// shadow rays that are segments between two random points, a tenth of either kind inactive.
-fn random_pairs(seed: u64, extent: f32) -> Vec<(PairRay, PairRay)> {
+/// Random pairs inside a cube of half-size `extent` around `centre`: closest rays from random
+/// points, and shadow rays that are segments between two random points, a tenth of either kind
+/// inactive.
+fn random_pairs(seed: u64, centre: Vec3, extent: f32) -> Vec<(PairRay, PairRay)> {
     let mut r = TestRng(seed);
-    let point = |r: &mut TestRng| (Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 2.0 - 1.0) * extent;
+    let point = |r: &mut TestRng| centre + (Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 2.0 - 1.0) * extent;
     (0..PAIRS)
         .map(|i| {
             let closest = PairRay {
@@ -98,7 +99,7 @@ fn assert_gpu_matches_twin(scene: &Scene, gpu_hits: &[(Hit, bool)], pairs: &[(Pa
 fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
     let ctx = gpu();
     let big = random_scene(5);
-    let pairs = random_pairs(6, 6.0);
+    let pairs = random_pairs(6, Vec3::ZERO, 6.0);
     let gpu_hits = run_gpu(&ctx, &big, false, &pairs);
     let hits = assert_gpu_matches_twin(&big, &gpu_hits, &pairs, false);
     assert!(hits > PAIRS / 4, "only {hits} of {PAIRS} closest rays hit");
@@ -107,7 +108,9 @@ fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
 
     // The Cornell box is small enough for uniform buffers on lavapipe: both forms there.
     let cornell = load_scene(&restir_pt::cli::bundled_file("scenes/cornell.gltf".as_ref())).unwrap();
-    let pairs = random_pairs(7, 0.99);
+    // The loader re-centres a scene on its first camera: the box is around its bounds' centre.
+    let (lo, hi) = cornell.bounds;
+    let pairs = random_pairs(7, 0.5 * (lo + hi), 0.99);
     for brute_force in [false, true] {
         let gpu_hits = run_gpu(&ctx, &cornell, brute_force, &pairs);
         let hits = assert_gpu_matches_twin(&cornell, &gpu_hits, &pairs, brute_force);
@@ -120,7 +123,7 @@ fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
 fn trace_pair_twin_equals_single_ray_traversals() {
     for (scene, extent) in [(random_scene(3), 6.0), (random_scene(11), 2.0)] {
         let (mut ties, mut hits) = (0, 0);
-        for (i, (c, s)) in random_pairs(12, extent).into_iter().enumerate() {
+        for (i, (c, s)) in random_pairs(12, Vec3::ZERO, extent).into_iter().enumerate() {
             let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, false, c, s);
             let (b, b_occluded) = trace_pair(&scene.nodes, &scene.triangles, true, c, s);
             if c.tmax > 0.0 {
