@@ -7,6 +7,9 @@ use glam::Vec3;
 
 use super::load_with_warnings;
 
+/// Materials listed one per line; vertex colours can make thousands of variants.
+const MAX_LISTED_MATERIALS: usize = 64;
+
 pub fn info(path: &Path) -> Result<()> {
     let scene = load_with_warnings(path)?;
     let (lo, hi) = scene.bounds;
@@ -20,13 +23,20 @@ pub fn info(path: &Path) -> Result<()> {
     );
     println!("environment: {:?}", scene.environment.to_array());
     println!("bounds: {:?} .. {:?} (extent {:.4})", lo.to_array(), hi.to_array(), scene.extent());
+    println!("punctual lights: {}", scene.lights.len());
+    for (i, l) in scene.lights.iter().enumerate() {
+        println!(
+            "  {i}: {:?} at {:?} along {:?}, intensity {:?}",
+            l.kind,
+            l.position.to_array(),
+            l.direction.to_array(),
+            l.intensity.to_array()
+        );
+    }
     println!("materials: {}", scene.materials.len());
-    for (m, name) in scene.materials.iter().zip(&scene.material_names) {
-        let used = scene
-            .triangles
-            .iter()
-            .filter(|t| scene.materials[t.material as usize] == *m)
-            .count();
+    let mut uses = vec![0usize; scene.materials.len()];
+    scene.triangles.iter().for_each(|t| uses[t.material as usize] += 1);
+    for ((m, name), used) in scene.materials.iter().zip(&scene.material_names).zip(uses).take(MAX_LISTED_MATERIALS) {
         println!(
             "  {name}: base {:?} metallic {} roughness {} transmission {} ior {} emission {:?}{} ({used} triangles)",
             m.base_color,
@@ -38,6 +48,9 @@ pub fn info(path: &Path) -> Result<()> {
             if m.is_double_sided() { " double-sided" } else { "" }
         );
     }
+    if scene.materials.len() > MAX_LISTED_MATERIALS {
+        println!("  ... and {} more", scene.materials.len() - MAX_LISTED_MATERIALS);
+    }
     println!("cameras: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {
         let p: Vec3 = c.position;
@@ -48,6 +61,9 @@ pub fn info(path: &Path) -> Result<()> {
             c.forward.to_array(),
             c.yfov.to_degrees()
         );
+        if let Some(a) = c.aspect_ratio {
+            println!("     aspect ratio {a:.4}");
+        }
     }
     Ok(())
 }

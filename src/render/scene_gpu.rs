@@ -8,6 +8,7 @@ use ash::vk::PhysicalDeviceType;
 
 use crate::bsdf::lobe_weights;
 use crate::error::GpuError;
+use crate::gpu_types::{Material, Triangle};
 use crate::scene::Scene;
 use crate::vk::{Binding, Buffer, Context};
 
@@ -34,10 +35,20 @@ impl SceneGpu {
         // Divergent uniform-buffer indexing serialises on GPUs; on llvmpipe it beats storage loads.
         let uniform = ctx.info.device_type == PhysicalDeviceType::CPU
             && arrays.iter().all(|&bytes| bytes as u64 <= ctx.info.max_uniform_buffer_range);
+        let placeholder = [Triangle::default()];
+        let no_material = [Material::default()];
         Ok(Self {
-            triangles: upload("triangles", Buffer::from_slice(ctx, "triangles", &scene.triangles))?,
+            // Vulkan has no empty buffers; a scene of points and lines alone has no triangles,
+            // and its BVH's one empty leaf never reads this placeholder.
+            triangles: upload(
+                "triangles",
+                Buffer::from_slice(ctx, "triangles", if scene.triangles.is_empty() { &placeholder } else { &scene.triangles }),
+            )?,
             nodes: upload("BVH nodes", Buffer::from_slice(ctx, "BVH nodes", &scene.nodes))?,
-            materials: upload("materials", Buffer::from_slice(ctx, "materials", &scene.materials))?,
+            materials: upload(
+                "materials",
+                Buffer::from_slice(ctx, "materials", if scene.materials.is_empty() { &no_material } else { &scene.materials }),
+            )?,
             emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &scene.emitters))?,
             uniform,
             defines: scene_defines(scene, uniform),
@@ -76,9 +87,9 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
     ];
     if uniform {
         defines.extend([
-            ("SCENE_TRIANGLE_COUNT", scene.triangles.len().to_string()),
+            ("SCENE_TRIANGLE_COUNT", scene.triangles.len().max(1).to_string()),
             ("SCENE_NODE_COUNT", scene.nodes.len().to_string()),
-            ("SCENE_MATERIAL_COUNT", scene.materials.len().to_string()),
+            ("SCENE_MATERIAL_COUNT", scene.materials.len().max(1).to_string()),
             ("SCENE_EMITTER_SLOTS", scene.emitters.len().max(1).to_string()),
         ]);
     }

@@ -4,6 +4,9 @@ use glam::{Mat4, Vec3};
 
 use crate::gpu_types::FrameParams;
 
+/// Vertical field of view of the default camera (45 degrees).
+pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Camera {
     pub name: String,
@@ -13,6 +16,8 @@ pub struct Camera {
     pub right: Vec3,
     /// Vertical field of view in radians.
     pub yfov: f32,
+    /// The glTF camera's `aspectRatio` (width / height), if it gives one.
+    pub aspect_ratio: Option<f32>,
 }
 
 impl Camera {
@@ -30,7 +35,20 @@ impl Camera {
             up,
             right,
             yfov,
+            aspect_ratio: None,
         }
+    }
+
+    /// The camera of a scene that has none: it looks along -Z (glTF's forward) at the centre of
+    /// the bounds `(lo, hi)`, from the distance at which their bounding sphere just fills a
+    /// vertical field of view of [`DEFAULT_YFOV`] (r / sin(yfov / 2) from the centre).
+    pub fn framing(bounds: (Vec3, Vec3)) -> Camera {
+        let (lo, hi) = bounds;
+        let centre = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(1e-6);
+        let distance = radius / (0.5 * DEFAULT_YFOV).sin();
+        let eye = centre + Vec3::Z * distance;
+        Camera::look_at("default camera", eye, centre, Vec3::Y, DEFAULT_YFOV)
     }
 
     pub fn look_at(name: &str, eye: Vec3, target: Vec3, up: Vec3, yfov: f32) -> Camera {
@@ -43,6 +61,7 @@ impl Camera {
             up: right.cross(forward),
             right,
             yfov,
+            aspect_ratio: None,
         }
     }
 

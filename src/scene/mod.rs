@@ -1,10 +1,17 @@
 //! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
 
 mod camera;
+mod gltf_json;
 mod gltf_loader;
+mod gltf_material;
+mod gltf_mesh;
+mod punctual;
 
-pub use camera::Camera;
-pub use gltf_loader::{load_scene, load_scene_from_bytes};
+pub use camera::{Camera, DEFAULT_YFOV};
+pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, LoadOptions, DEFAULT_ENVIRONMENT};
+pub use gltf_material::spec_gloss_to_metal_rough;
+pub use gltf_mesh::triangle_indices;
+pub use punctual::{PunctualKind, PunctualLight};
 
 use glam::Vec3;
 use std::path::PathBuf;
@@ -28,6 +35,8 @@ pub struct Scene {
     pub environment: Vec3,
     pub env_select_prob: f32,
     pub cameras: Vec<Camera>,
+    /// `KHR_lights_punctual` lights in world space.
+    pub lights: Vec<PunctualLight>,
     pub bounds: (Vec3, Vec3),
     /// Things the loader dropped or ignored; each line names the file.
     pub warnings: Vec<String>,
@@ -45,6 +54,7 @@ pub struct SceneParts {
     pub material_names: Vec<String>,
     pub environment: Vec3,
     pub cameras: Vec<Camera>,
+    pub lights: Vec<PunctualLight>,
     pub warnings: Vec<String>,
 }
 
@@ -79,6 +89,7 @@ impl Scene {
             (true, false) => ENV_SELECT_PROB_WITH_EMITTERS,
         };
         let root = bvh.nodes[0];
+        let triangles_empty = triangles.is_empty();
         Scene {
             source: parts.source,
             triangles,
@@ -90,7 +101,13 @@ impl Scene {
             environment: parts.environment,
             env_select_prob,
             cameras: parts.cameras,
-            bounds: (Vec3::from(root.lo), Vec3::from(root.hi)),
+            lights: parts.lights,
+            // A scene of points and lines alone has no triangles (and an empty root box).
+            bounds: if triangles_empty {
+                (Vec3::ZERO, Vec3::ZERO)
+            } else {
+                (Vec3::from(root.lo), Vec3::from(root.hi))
+            },
             warnings: parts.warnings,
         }
     }
@@ -98,4 +115,20 @@ impl Scene {
     pub fn extent(&self) -> f32 {
         (self.bounds.1 - self.bounds.0).max_element()
     }
+}
+
+/// Identical lines collapsed into one with their count ("line (x3)"), in order of first
+/// appearance.
+pub fn collapse_warnings(warnings: &[String]) -> Vec<String> {
+    let mut order: Vec<(&str, usize)> = Vec::new();
+    for w in warnings {
+        match order.iter_mut().find(|(s, _)| *s == w.as_str()) {
+            Some((_, n)) => *n += 1,
+            None => order.push((w.as_str(), 1)),
+        }
+    }
+    order
+        .into_iter()
+        .map(|(s, n)| if n > 1 { format!("{s} (x{n})") } else { s.to_string() })
+        .collect()
 }

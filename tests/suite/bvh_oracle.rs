@@ -64,6 +64,7 @@ pub fn random_scene(seed: u64) -> Scene {
         material_names: vec!["grey".into(), "light".into()],
         environment: Vec3::new(0.2, 0.3, 0.4),
         cameras: vec![Camera::look_at("test", Vec3::new(0.0, 1.0, 12.0), Vec3::ZERO, Vec3::Y, 0.8)],
+        lights: vec![],
         warnings: vec![],
     })
 }

@@ -85,9 +85,17 @@ fn loader_drops_degenerate_triangles_and_zero_area_emitters_with_warnings() {
 }
 
 #[test]
-fn loader_rejects_scenes_without_light_or_triangles() {
+fn loader_gives_a_lightless_scene_the_default_environment_and_rejects_one_without_triangles() {
     let path = scene_file("dark.gltf", floor(), None, |_| {});
-    assert!(load_error(&path).contains("no light"));
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.environment, restir_pt::scene::DEFAULT_ENVIRONMENT);
+    assert_eq!(scene.environment, Vec3::ONE);
+    assert_eq!(scene.env_select_prob, 1.0);
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("dark.gltf") && w.contains("no light") && w.contains("radiance 1")),
+        "{:?}",
+        scene.warnings
+    );
     let empty = MeshData {
         positions: vec![Vec3::ZERO; 3],
         indices: vec![0, 1, 2],
