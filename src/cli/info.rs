@@ -5,13 +5,14 @@ use std::path::Path;
 use anyhow::Result;
 use glam::Vec3;
 
-use super::load_with_warnings;
+use super::load_with_options;
+use crate::scene::LoadOptions;
 
 /// Materials listed one per line; vertex colours can make thousands of variants.
 const MAX_LISTED_MATERIALS: usize = 64;
 
-pub fn info(path: &Path) -> Result<()> {
-    let scene = load_with_warnings(path)?;
+pub fn info(path: &Path, options: &LoadOptions) -> Result<()> {
+    let scene = load_with_options(path, options)?;
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());

@@ -4,6 +4,9 @@ use glam::{Mat4, Vec3};
 
 use crate::gpu_types::FrameParams;
 
+/// The side of an image whose size neither the command line nor the camera sets.
+pub const DEFAULT_IMAGE_SIDE: u32 = 256;
+
 /// Vertical field of view of the default camera (45 degrees).
 pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
@@ -65,9 +68,36 @@ impl Camera {
         }
     }
 
+    /// tan(vertical field of view / 2) for an image of `width` x `height`. The camera's view is
+    /// fitted into the image: an image wider than the camera's `aspect_ratio` keeps yfov and shows
+    /// more at the sides; a narrower one widens the vertical field of view until the camera's
+    /// horizontal field of view (yfov and `aspect_ratio`) fits, so nothing of the intended view
+    /// is cropped. Without `aspect_ratio`, yfov is kept (glTF: the viewport's ratio is used).
+    pub fn tan_half_fov(&self, width: u32, height: u32) -> f32 {
+        let tan_half = (0.5 * self.yfov).tan();
+        let image_aspect = width as f32 / height as f32;
+        match self.aspect_ratio {
+            Some(a) if image_aspect < a => tan_half * a / image_aspect,
+            _ => tan_half,
+        }
+    }
+
+    /// The image size for the requested sides: both given, they are used; one given, the other
+    /// follows the camera's `aspect_ratio` (without one, it is [`DEFAULT_IMAGE_SIDE`]); none
+    /// given, [`DEFAULT_IMAGE_SIDE`] squared.
+    pub fn image_size(&self, width: Option<u32>, height: Option<u32>) -> (u32, u32) {
+        let side = |x: f32| (x.round() as u32).max(1);
+        match (width, height, self.aspect_ratio) {
+            (Some(w), Some(h), _) => (w, h),
+            (Some(w), None, Some(a)) => (w, side(w as f32 / a)),
+            (None, Some(h), Some(a)) => (side(h as f32 * a), h),
+            (w, h, _) => (w.unwrap_or(DEFAULT_IMAGE_SIDE), h.unwrap_or(DEFAULT_IMAGE_SIDE)),
+        }
+    }
+
     /// Writes the camera rows of the frame parameters for an image of `width` x `height`.
     pub fn fill_params(&self, params: &mut FrameParams, width: u32, height: u32) {
-        let tan_half = (0.5 * self.yfov).tan();
+        let tan_half = self.tan_half_fov(width, height);
         params.cam_position = self.position.extend(tan_half).into();
         params.cam_right = self.right.extend(width as f32 / height as f32).into();
         params.cam_up = self.up.extend(0.0).into();
@@ -77,7 +107,7 @@ impl Camera {
     /// Twin of GLSL `camera_ray_dir` (glsl/camera.glsl): direction through image point (px, py),
     /// in pixels from the top-left corner.
     pub fn ray_dir(&self, px: f32, py: f32, width: u32, height: u32) -> Vec3 {
-        let tan_half = (0.5 * self.yfov).tan();
+        let tan_half = self.tan_half_fov(width, height);
         let aspect = width as f32 / height as f32;
         let x = (2.0 * px / width as f32 - 1.0) * tan_half * aspect;
         let y = (1.0 - 2.0 * py / height as f32) * tan_half;
