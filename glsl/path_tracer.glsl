@@ -9,6 +9,7 @@
 #include "bvh.glsl"
 #include "camera.glsl"
 #include "lights.glsl"
+#include "punctual.glsl"
 #include "rng.glsl"
 
 const float RAY_TMAX = 1e30;
@@ -18,6 +19,7 @@ const uint RR_START_DEPTH = 3u;
 
 // Whether the light sample is hidden from the shading point x (geometric normal ng).
 bool shadow_ray_occluded(vec3 x, vec3 ng, LightSample ls) {
+    if (SCENE_PUNCTUAL != 0 && is_punctual_light(ls.triangle)) return punctual_occluded(x, ng, ls.dir, ls.dist);
     if (ls.triangle == NO_EMITTER) return trace_occluded(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng), ls.dir, RAY_TMAX);
     Triangle light = triangles[ls.triangle];
     return segment_occluded(x, ng, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)));
@@ -78,7 +80,9 @@ bool path_step(inout PathState s) {
         vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
             if (!shadow_ray_occluded(x, ng, ls)) {
-                s.radiance += s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
+                // BSDF sampling never reaches a punctual light: NEE alone estimates it.
+                float w = is_punctual_light(ls.triangle) ? 1.0 : power_heuristic(ls.pdf, bsdf_pdf);
+                s.radiance += s.beta * f * ls.radiance * (w / ls.pdf);
             }
         }
     }

@@ -54,12 +54,15 @@ pub enum Exposure {
 pub const AUTO_EXPOSURE_KEY: f32 = 0.18;
 
 /// The exposure (EV) that maps the image's log-average luminance exp(mean(ln(1e-4 + L))) over its
-/// finite pixels to [`AUTO_EXPOSURE_KEY`]; 0 for an image with no light or no finite pixel.
+/// finite pixels of positive luminance to [`AUTO_EXPOSURE_KEY`] (pixels of exactly zero, such as
+/// a black background, would only darken the key); 0 for an image with no such pixel.
 pub fn auto_exposure_ev(pixels: &[Vec3]) -> f32 {
     let logs: Vec<f64> = pixels
         .iter()
         .filter(|p| p.is_finite())
-        .map(|&p| (1e-4 + crate::scene::luminance(p.max(Vec3::ZERO)) as f64).ln())
+        .map(|&p| crate::scene::luminance(p.max(Vec3::ZERO)) as f64)
+        .filter(|&l| l > 0.0)
+        .map(|l| (1e-4 + l).ln())
         .collect();
     if logs.is_empty() {
         return 0.0;

@@ -17,7 +17,7 @@ use glam::Vec3;
 use std::path::PathBuf;
 
 use crate::bvh::Bvh;
-use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER};
+use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::build_alias_table;
 
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
@@ -77,6 +77,14 @@ impl Scene {
                 powers.push(power);
             }
         }
+        let triangle_power = powers.iter().fold(0.0, |a, p| a + p);
+        // Punctual lights join the alias table after the triangles, chosen by power too.
+        let bounds = (Vec3::from(bvh.nodes[0].lo), Vec3::from(bvh.nodes[0].hi));
+        let scene_radius = if triangles.is_empty() { 1.0 } else { 0.5 * (bounds.1 - bounds.0).length() };
+        for (k, light) in parts.lights.iter().enumerate() {
+            emitter_tris.push(PUNCTUAL_LIGHT_BIT | k as u32);
+            powers.push(light.power(scene_radius).max(f32::MIN_POSITIVE));
+        }
         let emitters = if emitter_tris.is_empty() {
             Vec::new()
         } else {
@@ -97,7 +105,7 @@ impl Scene {
             materials: parts.materials,
             material_names: parts.material_names,
             emitters,
-            emitter_power: powers.iter().fold(0.0, |a, p| a + p),
+            emitter_power: triangle_power,
             environment: parts.environment,
             env_select_prob,
             cameras: parts.cameras,
@@ -110,6 +118,18 @@ impl Scene {
             },
             warnings: parts.warnings,
         }
+    }
+
+    /// The probability that light selection (given it chose no environment) picks punctual light
+    /// `k`: its alias-table entry follows the emissive triangles'.
+    pub fn light_select_pdf(&self, k: usize) -> f32 {
+        self.emitters[self.emitters.len() - self.lights.len() + k].select_pdf
+    }
+
+    /// The emitter-buffer rows of the punctual lights (see `gpu_types::punctual_rows`).
+    pub fn punctual_rows(&self) -> Vec<Emitter> {
+        let pdfs: Vec<f32> = (0..self.lights.len()).map(|k| self.light_select_pdf(k)).collect();
+        crate::gpu_types::punctual_rows(&self.lights, &pdfs)
     }
 
     pub fn extent(&self) -> f32 {

@@ -11,6 +11,7 @@ mod gris;
 mod layout;
 mod restir;
 mod rng_oracle;
+mod punctual;
 mod real_scenes;
 mod robustness;
 mod sampling_oracle;
