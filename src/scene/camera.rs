@@ -7,6 +7,9 @@ use crate::gpu_types::FrameParams;
 /// The side of an image whose size neither the command line nor the camera sets.
 pub const DEFAULT_IMAGE_SIDE: u32 = 256;
 
+/// From the scene's centre towards the default camera: normalize(0, 1, 2).
+pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(0.0, 0.447_213_6, 0.894_427_2);
+
 /// Vertical field of view of the default camera (45 degrees).
 pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
@@ -42,15 +45,16 @@ impl Camera {
         }
     }
 
-    /// The camera of a scene that has none: it looks along -Z (glTF's forward) at the centre of
-    /// the bounds `(lo, hi)`, from the distance at which their bounding sphere just fills a
-    /// vertical field of view of [`DEFAULT_YFOV`] (r / sin(yfov / 2) from the centre).
+    /// The camera of a scene that has none: it looks at the centre of the bounds `(lo, hi)`
+    /// along -[`DEFAULT_VIEW_DIRECTION`] (from the +Z side, glTF's front, 26.6 degrees above the
+    /// horizon so that flat ground is seen), from the distance at which their bounding sphere just
+    /// fills a vertical field of view of [`DEFAULT_YFOV`] (r / sin(yfov / 2) from the centre).
     pub fn framing(bounds: (Vec3, Vec3)) -> Camera {
         let (lo, hi) = bounds;
         let centre = 0.5 * (lo + hi);
         let radius = (0.5 * (hi - lo).length()).max(1e-6);
         let distance = radius / (0.5 * DEFAULT_YFOV).sin();
-        let eye = centre + Vec3::Z * distance;
+        let eye = centre + DEFAULT_VIEW_DIRECTION * distance;
         Camera::look_at("default camera", eye, centre, Vec3::Y, DEFAULT_YFOV)
     }
 

@@ -300,7 +300,7 @@ impl Loader<'_> {
         if this.cameras.is_empty() {
             let camera = Camera::framing(bounds);
             this.warn(format!(
-                "the scene has no perspective camera: using a default one at {:?} looking along -Z at the centre of the bounds, yfov {:.0} deg, framing their bounding sphere",
+                "the scene has no perspective camera: using a default one at {:?} looking at the centre of the bounds from +Z and 26.6 deg above, yfov {:.0} deg, framing their bounding sphere",
                 camera.position.to_array(),
                 camera.yfov.to_degrees()
             ));
