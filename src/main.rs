@@ -412,6 +412,7 @@ fn main() -> ExitCode {
             load: LoadOptions {
                 scene: r.scene_index,
                 environment: r.env,
+                max_binding_bytes: None,
             },
             exposure: r.exposure,
             device: r.device.into(),

@@ -12,10 +12,13 @@ use crate::scene::LoadOptions;
 const MAX_LISTED_MATERIALS: usize = 64;
 
 pub fn info(path: &Path, options: &LoadOptions) -> Result<()> {
+    let start = std::time::Instant::now();
     let scene = load_with_options(path, options)?;
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());
+    println!("loaded in {load_ms:.0} ms, of which BVH build and emitter table {:.0} ms", scene.build_ms);
     println!("BVH nodes: {}", scene.nodes.len());
     println!(
         "emitters: {} triangles, power {:.4} (luminance W)",

@@ -123,10 +123,20 @@ fn frame_camera(args: &RenderArgs, frame: u32) -> usize {
 
 pub fn render(args: RenderArgs) -> Result<()> {
     let path = scene_path(args.scene.as_deref());
-    let scene = load_with_options(&path, &args.load)?;
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
+        bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
+    }
+    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // accessor counts, before reading vertices or building the BVH.
+    let ctx = open_device(&args.device)?;
+    let load = LoadOptions {
+        max_binding_bytes: Some(ctx.info.max_storage_buffer_range),
+        ..args.load.clone()
+    };
+    let scene = load_with_options(&path, &load)?;
     let last_camera = frame_camera(&args, args.frames - 1);
     if last_camera >= scene.cameras.len() {
         bail!(
@@ -136,9 +146,6 @@ pub fn render(args: RenderArgs) -> Result<()> {
             args.camera,
             scene.cameras.len()
         );
-    }
-    if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
-        bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
     }
     let camera = scene.cameras.get(args.camera).unwrap_or(&scene.cameras[0]);
     let (width, height) = camera.image_size(args.width, args.height);
@@ -171,7 +178,6 @@ pub fn render(args: RenderArgs) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     }
 
-    let ctx = open_device(&args.device)?;
     let outputs = Outputs {
         out: &out,
         png: &png,

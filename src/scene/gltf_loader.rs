@@ -12,9 +12,9 @@ use super::{Camera, PunctualLight, Scene, SceneParts};
 use crate::gpu_types::{Material, Triangle};
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
-const MAX_NODE_DEPTH: usize = 256;
+pub(super) const MAX_NODE_DEPTH: usize = 256;
 /// Node instances visited; guards against exponential instancing blow-ups.
-const MAX_NODE_INSTANCES: usize = 1 << 20;
+pub(super) const MAX_NODE_INSTANCES: usize = 1 << 20;
 pub(super) const MAX_TRIANGLES: usize = 1 << 26;
 
 pub(super) struct Loader<'a> {
@@ -60,6 +60,9 @@ pub struct LoadOptions {
     pub scene: Option<usize>,
     /// An environment that replaces the file's (and the default one).
     pub environment: Option<Vec3>,
+    /// The device's per-binding limit (bytes): a file whose accessor counts promise more
+    /// triangles than one binding holds fails before its vertices are read.
+    pub max_binding_bytes: Option<u64>,
 }
 
 /// Loads a glTF or GLB file. Errors are one line naming the file and the problem; warnings are
@@ -204,6 +207,9 @@ impl Loader<'_> {
                 .or_else(|| doc.scenes().next())
                 .ok_or_else(|| problem(self.path, "the file has no scene"))?,
         };
+        if let Some(limit) = options.max_binding_bytes {
+            self.check_binding_budget(&scene, limit)?;
+        }
         self.walk_nodes(&scene)?;
         let environment = match options.environment {
             Some(env) => env,

@@ -1,6 +1,7 @@
 //! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
 
 mod camera;
+mod gltf_budget;
 mod gltf_json;
 mod gltf_loader;
 mod gltf_material;
@@ -40,6 +41,8 @@ pub struct Scene {
     pub bounds: (Vec3, Vec3),
     /// Things the loader dropped or ignored; each line names the file.
     pub warnings: Vec<String>,
+    /// Wall time of the BVH build and emitter table (ms).
+    pub build_ms: f64,
 }
 
 pub fn luminance(c: Vec3) -> f32 {
@@ -62,6 +65,7 @@ impl Scene {
     /// Builds the BVH (reordering triangles) and the emitter table. Triangles must be
     /// non-degenerate and finite; the loader guarantees it.
     pub fn build(parts: SceneParts) -> Scene {
+        let start = std::time::Instant::now();
         let bvh = Bvh::build(&parts.triangles);
         let mut triangles: Vec<Triangle> = bvh.order.iter().map(|&i| parts.triangles[i as usize]).collect();
         let mut emitter_tris = Vec::new();
@@ -117,6 +121,7 @@ impl Scene {
                 (Vec3::from(root.lo), Vec3::from(root.hi))
             },
             warnings: parts.warnings,
+            build_ms: start.elapsed().as_secs_f64() * 1e3,
         }
     }
 
