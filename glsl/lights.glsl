@@ -1,5 +1,7 @@
-// Next-event estimation: emissive triangles chosen by power through an alias table, uniform area
-// sampling, and a constant environment sampled uniformly over the sphere. Expects `triangles`,
+// Next-event estimation: emissive triangles and punctual lights chosen by power through an alias
+// table, uniform area sampling, and a constant environment sampled uniformly over the sphere. A
+// punctual light's sample is a delta: pdf is the discrete probability of choosing it, radiance
+// is I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
 // `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: src/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
@@ -15,14 +17,74 @@
 #ifndef SCENE_EMITTERS
 #define SCENE_EMITTERS 1
 #endif
+#ifndef SCENE_PUNCTUAL
+#define SCENE_PUNCTUAL 1
+#endif
 
 struct LightSample {
     vec3 dir;        // unit direction from the shading point towards the light
     float dist;      // distance to the light point; +inf for the environment
     vec3 radiance;   // emitted radiance towards the shading point (0 from a back face)
     float pdf;       // solid-angle pdf including the selection probability; 0 if impossible
-    uint triangle;   // the emitter triangle sampled, NO_EMITTER for the environment
+    uint triangle;   // the emitter triangle sampled, NO_EMITTER for the environment,
+                     // PUNCTUAL_LIGHT_BIT | k for punctual light k
 };
+
+bool is_punctual_light(uint id) { return id != NO_EMITTER && (id & PUNCTUAL_LIGHT_BIT) != 0u; }
+
+struct PunctualLight {
+    vec3 position;
+    uint kind;
+    vec3 direction;    // unit, the way the light shines
+    float cos_outer;
+    vec3 intensity;    // colour x intensity: candela (point, spot) or lux (directional)
+    float cos_inner;
+    float select_pdf;
+};
+
+Emitter punctual_row(uint k, uint row) { return emitters[emitter_count + PUNCTUAL_ROWS * k + row]; }
+
+PunctualLight punctual_light(uint k) {
+    Emitter r0 = punctual_row(k, 0u);
+    Emitter r1 = punctual_row(k, 1u);
+    Emitter r2 = punctual_row(k, 2u);
+    PunctualLight l;
+    l.position = vec3(uintBitsToFloat(r0.triangle), r0.select_pdf, r0.alias_prob);
+    l.kind = r0.alias;
+    l.direction = vec3(uintBitsToFloat(r1.triangle), r1.select_pdf, r1.alias_prob);
+    l.cos_outer = uintBitsToFloat(r1.alias);
+    l.intensity = vec3(uintBitsToFloat(r2.triangle), r2.select_pdf, r2.alias_prob);
+    l.cos_inner = uintBitsToFloat(r2.alias);
+    l.select_pdf = uintBitsToFloat(punctual_row(k, 3u).triangle);
+    return l;
+}
+
+// KHR_lights_punctual's smooth spot falloff for light leaving along dir_out; 1 for other kinds.
+float spot_falloff(PunctualLight l, vec3 dir_out) {
+    if (l.kind != PUNCTUAL_SPOT) return 1.0;
+    float scale = 1.0 / max(l.cos_inner - l.cos_outer, 1e-3);
+    float t = clamp((dot(l.direction, dir_out) - l.cos_outer) * scale, 0.0, 1.0);
+    return t * t;
+}
+
+// Direction from p towards light l, distance (+inf for directional) and I·falloff/d² or E.
+void punctual_arrival(PunctualLight l, vec3 p, out vec3 dir, out float dist, out vec3 value) {
+    if (l.kind == PUNCTUAL_DIRECTIONAL) {
+        dir = -l.direction;
+        dist = 1.0 / 0.0;
+        value = l.intensity;
+        return;
+    }
+    vec3 to_light = l.position - p;
+    float d2 = dot(to_light, to_light);
+    dir = vec3(0.0, 0.0, 1.0);
+    dist = 0.0;
+    value = vec3(0.0);
+    if (!(d2 > 0.0)) return;
+    dist = sqrt(d2);
+    dir = to_light / dist;
+    value = l.intensity * (spot_falloff(l, -dir) / d2);
+}
 
 // Emitted radiance of a triangle towards direction `to_viewer` (front face only unless double-sided).
 vec3 emitted_radiance(Triangle tri, vec3 to_viewer) {
@@ -57,6 +119,9 @@ float emitter_pdf(uint tri_index, vec3 dir, float dist) {
 
 float environment_pdf() { return env_select_prob() * UNIFORM_SPHERE_PDF; }
 
+// Probability that NEE chooses punctual light k (discrete, not a density).
+float punctual_pdf(uint k) { return (1.0 - env_select_prob()) * punctual_light(k).select_pdf; }
+
 // u.x selects the light, u.yz the point or direction.
 LightSample sample_light(vec3 p, vec3 u) {
     LightSample ls;
@@ -76,6 +141,21 @@ LightSample sample_light(vec3 p, vec3 u) {
     if (SCENE_EMITTERS == 0 || emitter_count == 0u) return ls;
     float u_select = (u.x - p_env) / (1.0 - p_env);
     Emitter e = emitters[alias_select(min(u_select, 0.99999994), emitter_count)];
+#if SCENE_PUNCTUAL
+    if (is_punctual_light(e.triangle)) {
+        uint k = e.triangle & ~PUNCTUAL_LIGHT_BIT;
+        vec3 dir, value;
+        float dist;
+        punctual_arrival(punctual_light(k), p, dir, dist, value);
+        if (!(dist > 0.0)) return ls;
+        ls.dir = dir;
+        ls.dist = dist;
+        ls.radiance = value;
+        ls.pdf = punctual_pdf(k);
+        ls.triangle = e.triangle;
+        return ls;
+    }
+#endif
     Triangle tri = triangles[e.triangle];
     ls.triangle = e.triangle;
     vec2 b = sample_triangle(u.yz);

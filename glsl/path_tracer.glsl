@@ -11,6 +11,7 @@
 #include "bvh.glsl"
 #include "camera.glsl"
 #include "lights.glsl"
+#include "punctual.glsl"
 #include "rng.glsl"
 #include "trace_pair.glsl"
 
@@ -20,12 +21,16 @@ const uint RR_START_DEPTH = 3u;
 
 
 // The ray that tells whether the light sample is hidden from the shading point x (geometric
-// normal ng, on triangle index tri): towards the environment, or the segment to the sampled
-// emitter point.
+// normal ng, on triangle index tri): towards a punctual light, the environment, or the segment
+// to the sampled emitter point.
 PairRay shadow_ray(vec3 x, vec3 ng, uint tri, LightSample ls) {
+    PairRay r;
+    if (SCENE_PUNCTUAL != 0 && is_punctual_light(ls.triangle)) {
+        punctual_ray(x, ng, tri, ls.dir, ls.dist, r.origin, r.dir, r.tmax);
+        return r;
+    }
     if (ls.triangle == NO_EMITTER) return PairRay(offset_ray_origin(x, dot(ls.dir, ng) > 0.0 ? ng : -ng, triangles[tri]), ls.dir, RAY_TMAX);
     Triangle light = triangles[ls.triangle];
-    PairRay r;
     segment_ray(x, ng, tri, x + ls.dir * ls.dist, normalize(cross(light.e1, light.e2)), ls.triangle, r.origin, r.dir, r.tmax);
     return r;
 }
@@ -97,7 +102,9 @@ bool path_step(inout PathState s) {
         vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
             s.shadow = shadow_ray(x, ng, hit.triangle, ls);
-            s.nee = s.beta * f * ls.radiance * (power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf);
+            // BSDF sampling never reaches a punctual light: NEE alone estimates it.
+            float w = is_punctual_light(ls.triangle) ? 1.0 : power_heuristic(ls.pdf, bsdf_pdf);
+            s.nee = s.beta * f * ls.radiance * (w / ls.pdf);
         }
     }
 

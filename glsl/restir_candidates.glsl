@@ -87,7 +87,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
                 vec3 weight = f_cos / ls.pdf;
                 // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand (equal
                 // to rounding): evaluating the BSDF again took 5% of the pass.
-                float end_weight = balance_heuristic(ls.pdf, bsdf_pdf);
+                float end_weight = vertex_is_punctual(light) ? 1.0 : balance_heuristic(ls.pdf, bsdf_pdf);
                 vec3 contribution = prefix * weight * end_emission(x, light) * end_weight;
                 if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u.x)) {
                     chosen = TracedCandidate(i + 1u, true, light, weight, end_weight, contribution);

@@ -8,6 +8,7 @@
 #include "bvh.glsl"
 #include "lights.glsl"
 #include "path_record.glsl"
+#include "punctual.glsl"
 #include "rng.glsl"
 
 const float SHIFT_RAY_TMAX = 1e30;
@@ -17,7 +18,9 @@ struct ShiftParams {
     float distance_threshold;
 };
 
-// A surface point, or (triangle == NO_HIT) a direction to the environment.
+// A surface point, or (triangle == NO_HIT) a direction to the environment, or (a punctual light
+// id, only as a path's last vertex) a punctual light's position, or for a directional light the
+// direction towards it.
 struct Vertex {
     vec3 pos;
     vec3 normal;
@@ -65,6 +68,21 @@ struct ShiftResult {
 
 bool vertex_is_escaped(Vertex v) { return v.triangle == NO_HIT; }
 
+bool vertex_is_punctual(Vertex v) { return SCENE_PUNCTUAL != 0 && is_punctual_light(v.triangle); }
+
+uint vertex_light(Vertex v) { return v.triangle & ~PUNCTUAL_LIGHT_BIT; }
+
+// Escaped, or on a directional light: `pos` is a direction and the vertex is infinitely far.
+bool vertex_is_at_infinity(Vertex v) {
+    return vertex_is_escaped(v) || (vertex_is_punctual(v) && punctual_light(vertex_light(v)).kind == PUNCTUAL_DIRECTIONAL);
+}
+
+// Punctual light `id` as a path vertex: its position, or the direction towards a directional one.
+Vertex vertex_punctual(uint id) {
+    PunctualLight l = punctual_light(id & ~PUNCTUAL_LIGHT_BIT);
+    return Vertex(l.kind == PUNCTUAL_DIRECTIONAL ? -l.direction : l.position, vec3(0.0), id);
+}
+
 Vertex vertex_on_surface(uint triangle, vec3 pos) {
     Triangle t = triangles[triangle];
     return Vertex(pos, normalize(cross(t.e1, t.e2)), triangle);
@@ -75,7 +93,7 @@ Vertex vertex_escaped(vec3 dir) { return Vertex(dir, vec3(0.0), NO_HIT); }
 Material material_of(Vertex v) { return materials[triangles[v.triangle].material]; }
 
 bool vertex_is_rough(Vertex v, ShiftParams params) {
-    if (vertex_is_escaped(v)) return true;
+    if (vertex_is_escaped(v) || vertex_is_punctual(v)) return true;
     Material m = material_of(v);
     float w_d, w_c, w_t;
     lobe_weights(m, w_d, w_c, w_t);
@@ -84,7 +102,7 @@ bool vertex_is_rough(Vertex v, ShiftParams params) {
 }
 
 bool is_reconnectable(Vertex prev, Vertex cur, ShiftParams params) {
-    bool far = vertex_is_escaped(cur) || length(prev.pos - cur.pos) >= params.distance_threshold;
+    bool far = vertex_is_at_infinity(cur) || length(prev.pos - cur.pos) >= params.distance_threshold;
     return !vertex_is_escaped(prev) && far && vertex_is_rough(prev, params) && vertex_is_rough(cur, params);
 }
 
@@ -98,7 +116,7 @@ uint reconnection_index(Path path, ShiftParams params) {
 }
 
 void direction(Vertex from, Vertex to, out vec3 dir, out float dist) {
-    if (vertex_is_escaped(to)) {
+    if (vertex_is_at_infinity(to)) {
         dir = to.pos;
         dist = 1.0 / 0.0;
     } else {
@@ -108,11 +126,17 @@ void direction(Vertex from, Vertex to, out vec3 dir, out float dist) {
     }
 }
 
-// The shadow ray between two vertices: a segment between surface points, or a ray towards an
-// escaped vertex's direction. One ray for both cases keeps one traversal per call site: every
-// call inlines a whole traversal, and llvmpipe's compile time grows with the copies.
+// The shadow ray between two vertices: a segment between surface points, a ray to a punctual
+// light, or a ray towards an escaped vertex's direction. One ray for every case keeps one
+// traversal per call site: every call inlines a whole traversal, and llvmpipe's compile time
+// grows with the copies.
 void visibility_ray(Vertex from, Vertex to, out vec3 origin, out vec3 dir, out float tmax) {
-    if (!vertex_is_escaped(to)) {
+    if (vertex_is_punctual(to)) {
+        vec3 to_light;
+        float dist;
+        direction(from, to, to_light, dist);
+        punctual_ray(from.pos, from.normal, from.triangle, to_light, dist, origin, dir, tmax);
+    } else if (!vertex_is_escaped(to)) {
         segment_ray(from.pos, from.normal, from.triangle, to.pos, to.normal, to.triangle, origin, dir, tmax);
     } else {
         origin = offset_ray_origin(from.pos, dot(to.pos, from.normal) > 0.0 ? from.normal : -from.normal, triangles[from.triangle]);
@@ -130,12 +154,21 @@ bool visible(Vertex from, Vertex to) {
 
 vec3 end_emission(Vertex from, Vertex end) {
     if (vertex_is_escaped(end)) return scene_env.rgb;
+    if (vertex_is_punctual(end)) {
+        vec3 dir, value;
+        float dist;
+        punctual_arrival(punctual_light(vertex_light(end)), from.pos, dir, dist, value);
+        return value;
+    }
     Triangle tri = triangles[end.triangle];
     if (tri.emitter == NO_EMITTER) return vec3(0.0);
     return emitted_radiance(tri, normalize(from.pos - end.pos));
 }
 
+// For a punctual light: the discrete probability of choosing it (whose ratio between two paths
+// to the same light is 1, as its geometry term is).
 float light_pdf(Vertex from, Vertex end) {
+    if (vertex_is_punctual(end)) return punctual_pdf(vertex_light(end));
     vec3 dir;
     float dist;
     direction(from, end, dir, dist);
@@ -145,7 +178,9 @@ float light_pdf(Vertex from, Vertex end) {
 // Balance-heuristic weight of the technique that ended a path at `end` from `x` (reached from
 // `before`): NEE (`nee_end`) or BSDF sampling. Both are evaluated from the vertices, so a shifted
 // path gets its own weight. After a delta lobe only BSDF sampling reaches the end: weight 1.
+// A punctual light is reached by NEE alone: weight 1 (BSDF sampling never ends on one).
 float end_mis_weight(Vertex x, vec3 before, Vertex end, bool nee_end, bool after_delta) {
+    if (vertex_is_punctual(end)) return nee_end ? 1.0 : 0.0;
     if (after_delta) return nee_end ? 0.0 : 1.0;
     vec3 dir;
     float dist;
@@ -166,6 +201,10 @@ Vertex hit_vertex(Hit hit) {
 bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex light) {
     ls = sample_light(x.pos, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
     if (!(ls.pdf > 0.0)) return false;
+    if (SCENE_PUNCTUAL != 0 && is_punctual_light(ls.triangle)) {
+        light = vertex_punctual(ls.triangle);
+        return true;
+    }
     light = ls.triangle == NO_EMITTER ? vertex_escaped(ls.dir) : vertex_on_surface(ls.triangle, x.pos + ls.dir * ls.dist);
     return true;
 }
@@ -290,7 +329,9 @@ Link reconnection_link(Vertex prev, vec3 before, Vertex x_r, bool nee_at_r) {
     float bsdf_pdf;
     link.f_cos = bsdf_eval_pdf(material_of(prev), prev.normal, normalize(before - prev.pos), link.dir, bsdf_pdf);
     link.pdf = nee_at_r ? light_pdf(prev, x_r) : bsdf_pdf;
-    link.geometry = vertex_is_escaped(x_r) ? 1.0 : abs(dot(x_r.normal, link.dir)) / (dist * dist);
+    // A punctual x_r is one fixed point (or direction) whichever predecessor joins it: no
+    // solid-angle-to-area factor, so its part of the Jacobian is 1.
+    link.geometry = vertex_is_escaped(x_r) || vertex_is_punctual(x_r) ? 1.0 : abs(dot(x_r.normal, link.dir)) / (dist * dist);
     return link;
 }
 
@@ -304,6 +345,7 @@ float pdf_after(Vertex x_r, vec3 dir_in, Vertex next, bool next_is_nee, out vec3
 }
 
 Vertex record_vertex(uint triangle, vec3 pos) {
+    if (SCENE_PUNCTUAL != 0 && is_punctual_light(triangle)) return vertex_punctual(triangle);
     return triangle == NO_HIT ? vertex_escaped(pos) : vertex_on_surface(triangle, pos);
 }
 

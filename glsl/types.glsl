@@ -38,12 +38,20 @@ struct BvhNode {
 const uint LEAF_COUNT_BITS = 4u;
 const uint LEAF_COUNT_MASK = 15u;
 
-// One emissive triangle with its alias-table entry (selection proportional to power).
+// One emissive triangle or punctual light with its alias-table entry (selection proportional
+// to power). After the emitter_count entries, the buffer holds PUNCTUAL_ROWS rows per punctual
+// light, each 16-byte row read as four words: (position, kind), (direction, cos outer),
+// (intensity, cos inner), (select pdf, 0, 0, 0). Twin: gpu_types::punctual_rows.
 struct Emitter {
-    uint triangle;
+    uint triangle;      // the triangle, or PUNCTUAL_LIGHT_BIT | light index
     float select_pdf;
     float alias_prob;
     uint alias;
 };
+const uint PUNCTUAL_LIGHT_BIT = 0x80000000u;
+const uint PUNCTUAL_ROWS = 4u;
+const uint PUNCTUAL_POINT = 0u;
+const uint PUNCTUAL_SPOT = 1u;
+const uint PUNCTUAL_DIRECTIONAL = 2u;
 
 #endif

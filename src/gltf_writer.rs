@@ -135,7 +135,12 @@ pub struct GltfBuilder {
     nodes: Vec<Value>,
     roots: Vec<usize>,
     extensions_used: Vec<&'static str>,
+    required: Vec<&'static str>,
+    lights: Vec<Value>,
 }
+
+/// glTF's primitive mode for triangle lists (the default).
+pub const MODE_TRIANGLES: u32 = 4;
 
 fn round6(x: f32) -> f64 {
     // Six decimals keep the JSON short and stable across platforms.
@@ -205,29 +210,83 @@ impl GltfBuilder {
     }
 
     pub fn mesh(&mut self, name: &str, data: &MeshData, material: usize) -> usize {
-        let positions: Vec<f32> = data.positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-        // Bounds over the finite positions only: non-finite data (loader tests) must reach the
+        self.mesh_primitive(name, &data.positions, &data.indices, MODE_TRIANGLES, None, material)
+    }
+
+    fn push_accessor(&mut self, accessor: Value) -> usize {
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    fn vec3_accessor(&mut self, values: &[Vec3], target: u32) -> usize {
+        let floats: Vec<f32> = values.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+        // Bounds over the finite values only: non-finite data (loader tests) must reach the
         // loader's own checks rather than fail JSON validation.
-        let finite = data.positions.iter().filter(|p| p.is_finite());
+        let finite = values.iter().filter(|p| p.is_finite());
         let lo = finite.clone().fold(Vec3::splat(f32::INFINITY), |a, &p| a.min(p));
         let hi = finite.fold(Vec3::splat(f32::NEG_INFINITY), |a, &p| a.max(p));
-        let pos_view = self.push_view(bytemuck::cast_slice(&positions), 34962);
-        let mut accessor = json!({ "bufferView": pos_view, "componentType": 5126, "count": data.positions.len(), "type": "VEC3" });
+        let view = self.push_view(bytemuck::cast_slice(&floats), target);
+        let mut accessor = json!({ "bufferView": view, "componentType": 5126, "count": values.len(), "type": "VEC3" });
         if lo.is_finite() && hi.is_finite() {
             accessor["min"] = vec_json(lo);
             accessor["max"] = vec_json(hi);
         }
-        self.accessors.push(accessor);
-        let pos_accessor = self.accessors.len() - 1;
-        let idx_view = self.push_view(bytemuck::cast_slice(&data.indices), 34963);
-        self.accessors
-            .push(json!({ "bufferView": idx_view, "componentType": 5125, "count": data.indices.len(), "type": "SCALAR" }));
-        let idx_accessor = self.accessors.len() - 1;
-        self.meshes.push(json!({
-            "name": name,
-            "primitives": [{ "attributes": { "POSITION": pos_accessor }, "indices": idx_accessor, "material": material }],
-        }));
+        self.push_accessor(accessor)
+    }
+
+    /// A mesh of one primitive drawn in glTF primitive `mode` (4 triangles, 5 strip, 6 fan, 0-3
+    /// points and lines), with optional per-vertex COLOR_0.
+    pub fn mesh_primitive(
+        &mut self,
+        name: &str,
+        positions: &[Vec3],
+        indices: &[u32],
+        mode: u32,
+        colours: Option<&[Vec3]>,
+        material: usize,
+    ) -> usize {
+        let pos_accessor = self.vec3_accessor(positions, 34962);
+        let idx_view = self.push_view(bytemuck::cast_slice(indices), 34963);
+        let idx_accessor =
+            self.push_accessor(json!({ "bufferView": idx_view, "componentType": 5125, "count": indices.len(), "type": "SCALAR" }));
+        let mut primitive = json!({ "attributes": { "POSITION": pos_accessor }, "indices": idx_accessor, "material": material });
+        if mode != MODE_TRIANGLES {
+            primitive["mode"] = json!(mode);
+        }
+        if let Some(c) = colours {
+            primitive["attributes"]["COLOR_0"] = json!(self.vec3_accessor(c, 34962));
+        }
+        self.meshes.push(json!({ "name": name, "primitives": [primitive] }));
         self.meshes.len() - 1
+    }
+
+    /// Adds a root node drawing `mesh` once per translation through `EXT_mesh_gpu_instancing`
+    /// (marked required).
+    pub fn instanced(&mut self, name: &str, mesh: usize, translations: &[Vec3]) -> usize {
+        let accessor = self.vec3_accessor(translations, 34962);
+        self.use_extension("EXT_mesh_gpu_instancing");
+        self.required.push("EXT_mesh_gpu_instancing");
+        self.nodes.push(json!({
+            "name": name,
+            "mesh": mesh,
+            "extensions": { "EXT_mesh_gpu_instancing": { "attributes": { "TRANSLATION": accessor } } },
+        }));
+        self.roots.push(self.nodes.len() - 1);
+        self.nodes.len() - 1
+    }
+
+    /// Adds a `KHR_lights_punctual` light (`light` is its JSON: type, color, intensity, spot) on a
+    /// root node at `position` shining along `direction`.
+    pub fn punctual_light(&mut self, light: Value, position: Vec3, direction: Vec3) {
+        self.use_extension("KHR_lights_punctual");
+        self.lights.push(light);
+        let q = Quat::from_rotation_arc(-Vec3::Z, direction.normalize());
+        self.nodes.push(json!({
+            "extensions": { "KHR_lights_punctual": { "light": self.lights.len() - 1 } },
+            "translation": vec_json(position),
+            "rotation": [round6(q.x), round6(q.y), round6(q.z), round6(q.w)],
+        }));
+        self.roots.push(self.nodes.len() - 1);
     }
 
     /// Adds a root node instancing `mesh` with a rotation about +Y (radians) and a translation.
@@ -282,6 +341,12 @@ impl GltfBuilder {
         });
         if !self.extensions_used.is_empty() {
             root["extensionsUsed"] = json!(self.extensions_used);
+        }
+        if !self.required.is_empty() {
+            root["extensionsRequired"] = json!(self.required);
+        }
+        if !self.lights.is_empty() {
+            root["extensions"] = json!({ "KHR_lights_punctual": { "lights": self.lights } });
         }
         let mut text = serde_json::to_string_pretty(&root).expect("JSON values always serialise");
         text.push('\n');

@@ -57,6 +57,37 @@ pub struct Emitter {
     pub alias: u32,
 }
 
+/// Set in `Emitter::triangle` (and in path vertices' triangle ids) for a punctual light: the low
+/// bits are the light's index in `Scene::lights`. Triangle indices stay below 2^26.
+pub const PUNCTUAL_LIGHT_BIT: u32 = 1 << 31;
+
+/// Rows of the emitter buffer per punctual light, after the alias table (glsl/types.glsl):
+/// (position, kind), (direction, cos outer), (intensity, cos inner), (select pdf, 0, 0, 0).
+pub const PUNCTUAL_ROWS: usize = 4;
+
+/// The emitter-buffer rows of punctual lights (`select_pdfs[k]`: light k's probability in the
+/// alias table), reinterpreting each 16-byte row as four 32-bit words.
+pub fn punctual_rows(lights: &[crate::scene::PunctualLight], select_pdfs: &[f32]) -> Vec<Emitter> {
+    let row = |a: [f32; 3], w: u32| Emitter {
+        triangle: a[0].to_bits(),
+        select_pdf: a[1],
+        alias_prob: a[2],
+        alias: w,
+    };
+    lights
+        .iter()
+        .zip(select_pdfs)
+        .flat_map(|(l, &pdf)| {
+            [
+                row(l.position.into(), l.kind as u32),
+                row(l.direction.into(), l.cos_outer.to_bits()),
+                row(l.intensity.into(), l.cos_inner.to_bits()),
+                row([pdf, 0.0, 0.0], 0),
+            ]
+        })
+        .collect()
+}
+
 impl Material {
     pub fn is_double_sided(&self) -> bool {
         self.flags & MATERIAL_DOUBLE_SIDED != 0

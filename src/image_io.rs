@@ -40,8 +40,56 @@ pub(crate) fn srgb_encode(linear: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
+/// The exposure of a PNG preview; the EXR is never changed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    /// Scale radiance by 2^EV.
+    Ev(f32),
+    /// [`auto_exposure_ev`] of the image.
+    Auto,
+}
+
+/// Middle grey: the log-average luminance an automatic exposure maps to (Reinhard et al. 2002,
+/// "Photographic Tone Reproduction for Digital Images", the key value a = 0.18).
+pub const AUTO_EXPOSURE_KEY: f32 = 0.18;
+
+/// The exposure (EV) that maps the image's log-average luminance exp(mean(ln(1e-4 + L))) over its
+/// finite pixels of positive luminance to [`AUTO_EXPOSURE_KEY`] (pixels of exactly zero, such as
+/// a black background, would only darken the key); 0 for an image with no such pixel.
+pub fn auto_exposure_ev(pixels: &[Vec3]) -> f32 {
+    let logs: Vec<f64> = pixels
+        .iter()
+        .filter(|p| p.is_finite())
+        .map(|&p| crate::scene::luminance(p.max(Vec3::ZERO)) as f64)
+        .filter(|&l| l > 0.0)
+        .map(|l| (1e-4 + l).ln())
+        .collect();
+    if logs.is_empty() {
+        return 0.0;
+    }
+    let key = (logs.iter().sum::<f64>() / logs.len() as f64).exp();
+    if key <= 1.01e-4 {
+        return 0.0;
+    }
+    (AUTO_EXPOSURE_KEY as f64 / key).log2() as f32
+}
+
+/// The EV that `exposure` applies to `image`.
+pub fn exposure_ev(exposure: Exposure, image: &Image) -> f32 {
+    match exposure {
+        Exposure::Ev(ev) => ev,
+        Exposure::Auto => auto_exposure_ev(&image.mean),
+    }
+}
+
 /// A preview: linear radiance clamped to [0, 1] and sRGB-encoded (no exposure change).
 pub fn write_png(path: &Path, image: &Image) -> Result<()> {
+    write_png_exposed(path, image, 0.0)
+}
+
+/// A preview: linear radiance times 2^`ev`, clamped to [0, 1] and sRGB-encoded.
+pub fn write_png_exposed(path: &Path, image: &Image, ev: f32) -> Result<()> {
+    let scale = ev.exp2();
     let file = std::fs::File::create(path).with_context(|| format!("{}: cannot create PNG", path.display()))?;
     let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), image.width, image.height);
     encoder.set_color(png::ColorType::Rgb);
@@ -49,6 +97,7 @@ pub fn write_png(path: &Path, image: &Image) -> Result<()> {
     let data: Vec<u8> = image
         .mean
         .iter()
+        .map(|&p| p * scale)
         .flat_map(|p| [srgb_encode(p.x), srgb_encode(p.y), srgb_encode(p.z)])
         .collect();
     encoder

@@ -5,7 +5,10 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
+use glam::Vec3;
+use restir_pt::image_io::Exposure;
 use restir_pt::render::{RestirSettings, ReuseMis, ShiftKind};
+use restir_pt::scene::LoadOptions;
 
 #[derive(Parser)]
 #[command(
@@ -23,8 +26,8 @@ enum Command {
     /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG with ReSTIR PT (default)
     /// or the path tracer.
     Render(RenderCmd),
-    /// Print a scene's triangles, emitters, materials, bounds and cameras; with --kernels, the
-    /// SPIR-V size and compile time of each kernel the scene would use.
+    /// Print a scene's triangles, emitters, lights, materials, bounds and cameras; with
+    /// --kernels, the SPIR-V size and compile time of each kernel the scene would use.
     Info(InfoCmd),
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
     Bench(BenchCmd),
@@ -78,6 +81,9 @@ enum MisOpt {
 #[derive(Args)]
 struct InfoCmd {
     scene: PathBuf,
+    /// The glTF scene to describe (index into the file's scenes; default: its default scene).
+    #[arg(long = "scene")]
+    scene_index: Option<usize>,
     /// Also build every kernel of the path tracer and of ReSTIR PT (with the shift and MIS
     /// given) and print its SPIR-V size and compile time per stage.
     #[arg(long)]
@@ -169,10 +175,22 @@ struct RenderCmd {
     /// Path-tracer samples per pixel (default 64); only with --method pt.
     #[arg(long)]
     spp: Option<u32>,
-    #[arg(long, default_value_t = 256)]
-    width: u32,
-    #[arg(long, default_value_t = 256)]
-    height: u32,
+    /// Image width; with --height alone it follows the camera's aspectRatio (default 256).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height; with --width alone it follows the camera's aspectRatio (default 256).
+    #[arg(long)]
+    height: Option<u32>,
+    /// The glTF scene to render (index into the file's scenes; default: its default scene).
+    #[arg(long = "scene")]
+    scene_index: Option<usize>,
+    /// Environment radiance R,G,B replacing the scene's (and the default one).
+    #[arg(long, value_parser = parse_env)]
+    env: Option<Vec3>,
+    /// PNG preview exposure: EV (radiance times 2^EV) or auto (log-average luminance to 0.18).
+    /// The EXR is never changed.
+    #[arg(long, default_value = "auto", value_parser = parse_exposure)]
+    exposure: Exposure,
     /// Maximum number of path segments: 1 shows only directly visible emitters, 2 adds direct
     /// lighting, each further step adds one bounce of indirect light (ReSTIR PT: at most 7).
     #[arg(long, default_value_t = 7)]
@@ -378,6 +396,24 @@ impl From<DeviceOpts> for DeviceArgs {
     }
 }
 
+fn parse_exposure(s: &str) -> Result<Exposure, String> {
+    if s == "auto" {
+        return Ok(Exposure::Auto);
+    }
+    match s.parse::<f32>() {
+        Ok(ev) if ev.is_finite() && ev.abs() <= 64.0 => Ok(Exposure::Ev(ev)),
+        _ => Err(format!("{s:?} is neither auto nor an EV between -64 and 64")),
+    }
+}
+
+fn parse_env(s: &str) -> Result<Vec3, String> {
+    let values: Vec<f32> = s.split(',').map(|v| v.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("{s:?}: {e}"))?;
+    match values[..] {
+        [r, g, b] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok(Vec3::new(r, g, b)),
+        _ => Err(format!("{s:?} must be R,G,B: three finite, non-negative radiances")),
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = match cli.command {
@@ -408,11 +444,21 @@ fn main() -> ExitCode {
             variance: r.variance,
             report: r.report,
             allow_nonfinite: r.allow_nonfinite,
+            load: LoadOptions {
+                scene: r.scene_index,
+                environment: r.env,
+                max_binding_bytes: None,
+            },
+            exposure: r.exposure,
             device: r.device.into(),
         }),
         Command::Info(i) => {
             let kernels = i.kernels.then(|| (i.restir.settings(), i.device.into()));
-            cli::info(&i.scene, kernels)
+            let load = LoadOptions {
+                scene: i.scene_index,
+                ..Default::default()
+            };
+            cli::info(&i.scene, &load, kernels)
         }
         Command::Reference(r) => cli::reference(cli::ReferenceArgs {
             scene: r.scene,

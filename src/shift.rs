@@ -13,13 +13,24 @@
 //! where the first ratio is 1 for a light point chosen by NEE (area sampling ignores the shading
 //! point), only the pdf ratio remains for an escaped direction, and the second ratio is 1 when
 //! x_r is the end or x_{r+1} is the NEE end.
+//!
+//! Punctual (delta) lights end paths only through NEE. Their "pdf" is the discrete probability
+//! of choosing the light and their geometry term is 1: the light is one fixed point (or, for a
+//! directional light, one direction) whichever vertex joins it, so a reconnection onto it has a
+//! first Jacobian ratio of 1. Random replay chooses the same light again (the choice depends on
+//! the random number alone); reconnection and hybrid may reconnect onto it as onto any rough end
+//! vertex (docs/shift-mappings.md, "Delta lights").
 
 use glam::Vec3;
 
 use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
 use crate::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
-use crate::gpu_types::NO_EMITTER;
-use crate::lights::{emitted_radiance, emitter_pdf, environment_pdf, sample_light};
+use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use crate::lights::{
+    emitted_radiance, emitter_pdf, environment_pdf, is_punctual_light, punctual_arrival, punctual_occluded, punctual_pdf,
+    sample_light,
+};
+use crate::scene::PunctualKind;
 use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
 use crate::ray_offset::offset_ray_origin;
 use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
@@ -58,6 +69,31 @@ pub struct Vertex {
 impl Vertex {
     pub fn is_escaped(&self) -> bool {
         self.triangle == NO_HIT
+    }
+
+    /// On punctual light `triangle & !PUNCTUAL_LIGHT_BIT` (only as a path's last vertex).
+    pub fn is_punctual(&self) -> bool {
+        is_punctual_light(self.triangle)
+    }
+
+    fn light(&self) -> u32 {
+        self.triangle & !PUNCTUAL_LIGHT_BIT
+    }
+
+    /// Escaped, or on a directional light: `pos` is a direction, the vertex infinitely far.
+    pub fn is_at_infinity(&self, scene: &Scene) -> bool {
+        self.is_escaped() || (self.is_punctual() && scene.lights[self.light() as usize].kind == PunctualKind::Directional)
+    }
+
+    /// Punctual light `id` as a vertex: its position, or the direction towards a directional one.
+    pub fn punctual(scene: &Scene, id: u32) -> Vertex {
+        let l = &scene.lights[(id & !PUNCTUAL_LIGHT_BIT) as usize];
+        let pos = if l.kind == PunctualKind::Directional { -l.direction } else { l.position };
+        Vertex {
+            pos,
+            normal: Vec3::ZERO,
+            triangle: id,
+        }
     }
 
     pub fn on_surface(scene: &Scene, triangle: u32, pos: Vec3) -> Vertex {
@@ -146,7 +182,7 @@ impl ShiftResult {
 /// Whether a vertex may be a reconnection endpoint: every lobe of its material is rough
 /// (diffuse, or GGX at least as rough as the threshold). Escaped directions count as rough.
 pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool {
-    if v.is_escaped() {
+    if v.is_escaped() || v.is_punctual() {
         return true;
     }
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
@@ -158,7 +194,7 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
 
 /// The reconnection test for the pair (prev, cur): both rough and far enough apart.
 pub fn is_reconnectable(scene: &Scene, prev: &Vertex, cur: &Vertex, params: &ShiftParams) -> bool {
-    let far = cur.is_escaped() || prev.pos.distance(cur.pos) >= params.distance_threshold;
+    let far = cur.is_at_infinity(scene) || prev.pos.distance(cur.pos) >= params.distance_threshold;
     !prev.is_escaped() && far && vertex_is_rough(scene, prev, params) && vertex_is_rough(scene, cur, params)
 }
 
@@ -173,8 +209,8 @@ fn material_of(scene: &Scene, v: &Vertex) -> crate::gpu_types::Material {
 }
 
 /// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
-fn direction(from: &Vertex, to: &Vertex) -> (Vec3, f32) {
-    if to.is_escaped() {
+fn direction(scene: &Scene, from: &Vertex, to: &Vertex) -> (Vec3, f32) {
+    if to.is_at_infinity(scene) {
         (to.pos, f32::INFINITY)
     } else {
         let d = to.pos - from.pos;
@@ -184,6 +220,10 @@ fn direction(from: &Vertex, to: &Vertex) -> (Vec3, f32) {
 }
 
 fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
+    if to.is_punctual() {
+        let (dir, dist) = direction(scene, from, to);
+        return !punctual_occluded(scene, from.pos, from.normal, from.triangle, dir, dist);
+    }
     if !to.is_escaped() {
         return !segment_occluded(
             &scene.nodes,
@@ -206,6 +246,9 @@ fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     if end.is_escaped() {
         return scene.environment;
     }
+    if end.is_punctual() {
+        return punctual_arrival(&scene.lights[end.light() as usize], from.pos).2;
+    }
     let tri = &scene.triangles[end.triangle as usize];
     if tri.emitter == NO_EMITTER {
         return Vec3::ZERO;
@@ -213,9 +256,13 @@ fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     emitted_radiance(scene, tri, (from.pos - end.pos).normalize())
 }
 
-/// Solid-angle pdf that NEE at `from` picks `end`.
+/// Solid-angle pdf that NEE at `from` picks `end`; for a punctual light the discrete probability
+/// of choosing it.
 fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
-    let (dir, dist) = direction(from, end);
+    if end.is_punctual() {
+        return punctual_pdf(scene, end.light());
+    }
+    let (dir, dist) = direction(scene, from, end);
     if end.is_escaped() {
         environment_pdf(scene)
     } else {
@@ -227,10 +274,14 @@ fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
 /// `before`): NEE (`nee_end`) or BSDF sampling, evaluated from the vertices so that a shifted
 /// path gets its own weight. After a delta lobe only BSDF sampling reaches the end: weight 1.
 pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee_end: bool, after_delta: bool) -> f32 {
+    // NEE alone reaches a punctual light.
+    if end.is_punctual() {
+        return if nee_end { 1.0 } else { 0.0 };
+    }
     if after_delta {
         return if nee_end { 0.0 } else { 1.0 };
     }
-    let (dir, _) = direction(x, end);
+    let (dir, _) = direction(scene, x, end);
     let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, (before - x.pos).normalize(), dir);
     let light = light_pdf(scene, x, end);
     if nee_end {
@@ -285,7 +336,9 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
             if !(ls.pdf > 0.0) {
                 return None;
             }
-            let end = if ls.triangle == NO_EMITTER {
+            let end = if is_punctual_light(ls.triangle) {
+                Vertex::punctual(scene, ls.triangle)
+            } else if ls.triangle == NO_EMITTER {
                 Vertex::escaped(ls.dir)
             } else {
                 Vertex::on_surface(scene, ls.triangle, x.pos + ls.dir * ls.dist)
@@ -458,10 +511,11 @@ struct Link {
 }
 
 fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, nee_at_r: bool) -> Link {
-    let (dir, dist) = direction(prev, x_r);
+    let (dir, dist) = direction(scene, prev, x_r);
     let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, prev), prev.normal, (before - prev.pos).normalize(), dir);
     let pdf = if nee_at_r { light_pdf(scene, prev, x_r) } else { bsdf_pdf };
-    let geometry = if x_r.is_escaped() {
+    // A punctual x_r is one fixed point or direction whatever joins it: no area factor.
+    let geometry = if x_r.is_escaped() || x_r.is_punctual() {
         1.0
     } else {
         x_r.normal.dot(dir).abs() / (dist * dist)
@@ -472,13 +526,15 @@ fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, n
 /// f_s |cos| at x_r arriving along `dir_in` and leaving to `next`, and the pdf that chose `next`
 /// from x_r (the light's when NEE chose it).
 fn pdf_after(scene: &Scene, x_r: &Vertex, dir_in: Vec3, next: &Vertex, next_is_nee: bool) -> (Vec3, f32) {
-    let (dir_next, _) = direction(x_r, next);
+    let (dir_next, _) = direction(scene, x_r, next);
     let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, -dir_in, dir_next);
     (f_cos, if next_is_nee { light_pdf(scene, x_r, next) } else { pdf })
 }
 
 fn record_vertex(scene: &Scene, triangle: u32, pos: [f32; 3]) -> Vertex {
-    if triangle == NO_HIT {
+    if is_punctual_light(triangle) {
+        Vertex::punctual(scene, triangle)
+    } else if triangle == NO_HIT {
         Vertex::escaped(Vec3::from(pos))
     } else {
         Vertex::on_surface(scene, triangle, Vec3::from(pos))

@@ -62,6 +62,68 @@ fn glb(mut json: Value) -> Vec<u8> {
     out
 }
 
+/// The floor drawn as a triangle strip and the lamp as a triangle fan (same triangles, same
+/// winding as the quads' lists).
+fn strips_and_fans() -> Value {
+    let mut b = GltfBuilder::default();
+    let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
+    let light = b.material("light", MaterialSpec::emitter(Vec3::splat(5.0)));
+    let f = b.mesh_primitive("floor strip", &floor().positions, &[1, 2, 0, 3], 5, None, grey);
+    b.instance("floor", f, 0.0, Vec3::ZERO);
+    let l = b.mesh_primitive("lamp fan", &lamp().positions, &[0, 1, 2, 3], 6, None, light);
+    b.instance("lamp", l, 0.0, Vec3::ZERO);
+    let segment = b.mesh_primitive("a line", &[Vec3::ZERO, Vec3::Y], &[0, 1], 1, None, grey);
+    b.instance("line", segment, 0.0, Vec3::ZERO);
+    b.camera("camera", Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, 0.8);
+    serde_json::from_str(&b.finish("strips and fans", Vec3::ZERO)).expect("the builder writes JSON")
+}
+
+/// Three instances of a small floor tile through EXT_mesh_gpu_instancing, under the lamp.
+fn instanced() -> Value {
+    let mut b = GltfBuilder::default();
+    let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
+    let light = b.material("light", MaterialSpec::emitter(Vec3::splat(5.0)));
+    let tile = MeshData::quad(Vec3::new(-0.3, 0.0, -0.3), Vec3::Z * 0.6, Vec3::X * 0.6);
+    let t = b.mesh("tile", &tile, grey);
+    b.instanced("tiles", t, &[Vec3::new(-0.7, 0.0, 0.0), Vec3::ZERO, Vec3::new(0.7, 0.0, 0.0)]);
+    let l = b.mesh("lamp", &lamp(), light);
+    b.instance("lamp", l, 0.0, Vec3::ZERO);
+    b.camera("camera", Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, 0.8);
+    serde_json::from_str(&b.finish("instanced", Vec3::ZERO)).expect("the builder writes JSON")
+}
+
+/// A floor with per-vertex colours (red, green, blue, white corners) and the lamp.
+fn vertex_colours() -> Value {
+    let mut b = GltfBuilder::default();
+    let white = b.material("white", MaterialSpec::diffuse(Vec3::ONE));
+    let light = b.material("light", MaterialSpec::emitter(Vec3::splat(5.0)));
+    let f = floor();
+    let colours = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE];
+    let m = b.mesh_primitive("floor", &f.positions, &f.indices, 4, Some(&colours), white);
+    b.instance("floor", m, 0.0, Vec3::ZERO);
+    let l = b.mesh("lamp", &lamp(), light);
+    b.instance("lamp", l, 0.0, Vec3::ZERO);
+    b.camera("camera", Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, 0.8);
+    serde_json::from_str(&b.finish("vertex colours", Vec3::ZERO)).expect("the builder writes JSON")
+}
+
+/// The floor lit by a point light 1 above it (no emissive triangle, no environment).
+fn punctual_lit() -> Value {
+    let mut b = GltfBuilder::default();
+    let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
+    let f = b.mesh("floor", &floor(), grey);
+    b.instance("floor", f, 0.0, Vec3::ZERO);
+    b.punctual_light(json!({ "type": "point", "color": [1.0, 0.9, 0.8], "intensity": 3.0 }), Vec3::Y, -Vec3::Y);
+    b.punctual_light(
+        json!({ "type": "spot", "intensity": 5.0, "spot": { "innerConeAngle": 0.3, "outerConeAngle": 0.6 } }),
+        Vec3::new(0.5, 1.5, 0.5),
+        -Vec3::Y,
+    );
+    b.punctual_light(json!({ "type": "directional", "intensity": 0.5 }), Vec3::ZERO, Vec3::new(0.3, -1.0, 0.2));
+    b.camera("camera", Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, 0.8);
+    serde_json::from_str(&b.finish("punctual", Vec3::ZERO)).expect("the builder writes JSON")
+}
+
 fn decode_base64(s: &str) -> Vec<u8> {
     let value = |c: u8| match c {
         b'A'..=b'Z' => c - b'A',
@@ -108,6 +170,52 @@ fn main() -> anyhow::Result<()> {
         ("not-gltf.gltf", b"this is not a glTF file\n".to_vec()),
         ("empty-file.gltf", Vec::new()),
         ("missing-bin.gltf", edited(|v| v["buffers"][0]["uri"] = json!("missing.bin"))),
+        ("strips-and-fans.gltf", serde_json::to_vec_pretty(&strips_and_fans())?),
+        ("instanced.gltf", serde_json::to_vec_pretty(&instanced())?),
+        ("vertex-colours.gltf", serde_json::to_vec_pretty(&vertex_colours())?),
+        ("punctual-lit.gltf", serde_json::to_vec_pretty(&punctual_lit())?),
+        (
+            "animated.gltf",
+            edited(|v| {
+                // A channel without a target node is valid glTF (KHR_animation_pointer uses it).
+                v["animations"] = json!([{
+                    "channels": [{ "sampler": 0, "target": { "path": "translation" } }],
+                    "samplers": [{ "input": 0, "output": 0 }],
+                }]);
+                v["meshes"][0]["primitives"][0]["targets"] = json!([{ "POSITION": 0 }]);
+            }),
+        ),
+        (
+            "unlit.gltf",
+            edited(|v| {
+                v["materials"][0]["extensions"] = json!({ "KHR_materials_unlit": {} });
+                v["extensionsUsed"] = json!(["KHR_materials_unlit"]);
+                v["extensionsRequired"] = json!(["KHR_materials_unlit"]);
+            }),
+        ),
+        (
+            "spec-gloss.gltf",
+            edited(|v| {
+                v["materials"][0]["extensions"] = json!({ "KHR_materials_pbrSpecularGlossiness": {
+                    "diffuseFactor": [0.5, 0.4, 0.3, 1.0], "specularFactor": [0.04, 0.04, 0.04], "glossinessFactor": 0.2 } });
+                v["extensionsUsed"] = json!(["KHR_materials_pbrSpecularGlossiness"]);
+                v["extensionsRequired"] = json!(["KHR_materials_pbrSpecularGlossiness"]);
+            }),
+        ),
+        (
+            "meshopt-required.gltf",
+            edited(|v| {
+                v["extensionsUsed"] = json!(["EXT_meshopt_compression"]);
+                v["extensionsRequired"] = json!(["EXT_meshopt_compression"]);
+            }),
+        ),
+        (
+            "warnings-then-error.gltf",
+            edited(|v| {
+                v["animations"] = json!([{ "channels": [], "samplers": [] }]);
+                v["accessors"][0]["count"] = json!(1_000_000_000u64);
+            }),
+        ),
         ("index-out-of-range.gltf", serde_json::to_vec_pretty(&base(out_of_range, lamp()))?),
         ("nan-position.gltf", serde_json::to_vec_pretty(&base(nan, lamp()))?),
         ("inf-position.gltf", serde_json::to_vec_pretty(&base(inf, lamp()))?),

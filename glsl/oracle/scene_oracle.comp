@@ -1,6 +1,7 @@
 #version 460
 // Oracle kernel: BVH traversal, light sampling and camera rays against a real scene
-// (twins: src/bvh.rs, src/ray_offset.rs, src/lights.rs, src/scene/camera.rs).
+// (twins: src/bvh.rs, src/ray_offset.rs, src/lights.rs, src/scene/camera.rs), and shadow rays
+// to punctual lights.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
@@ -8,6 +9,7 @@ layout(local_size_x = 64) in;
 #include "../bvh.glsl"
 #include "../camera.glsl"
 #include "../lights.glsl"
+#include "../punctual.glsl"
 
 // Per item: origin (w: tmax), direction, light-sample uniforms (xyz), image point (xy).
 layout(std430, set = 0, binding = 5) readonly buffer Inputs { vec4 inputs[]; };
@@ -24,9 +26,12 @@ void main() {
     Hit h = trace_closest(o.xyz, d, o.w);
     bool occluded = trace_occluded(o.xyz, d, o.w);
     LightSample ls = sample_light(o.xyz, u);
-    outputs[5u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
-    outputs[5u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d, triangles[i % uint(triangles.length())]));
-    outputs[5u * i + 2u] = vec4(ls.dir, ls.dist);
-    outputs[5u * i + 3u] = vec4(ls.radiance, ls.pdf);
-    outputs[5u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), uintBitsToFloat(ls.triangle));
+    uint offset_triangle = i % uint(triangles.length());
+    bool shadowed = is_punctual_light(ls.triangle) && punctual_occluded(o.xyz, d, offset_triangle, ls.dir, ls.dist);
+    outputs[6u * i + 5u] = vec4(shadowed ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+    outputs[6u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
+    outputs[6u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d, triangles[offset_triangle]));
+    outputs[6u * i + 2u] = vec4(ls.dir, ls.dist);
+    outputs[6u * i + 3u] = vec4(ls.radiance, ls.pdf);
+    outputs[6u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), uintBitsToFloat(ls.triangle));
 }

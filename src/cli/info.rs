@@ -5,15 +5,22 @@ use std::path::Path;
 use anyhow::Result;
 use glam::Vec3;
 
-use super::{finish_device, load_with_warnings, open_device, DeviceArgs};
+use super::{finish_device, load_with_options, open_device, DeviceArgs};
 use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings};
+use crate::scene::LoadOptions;
 use crate::vk::KernelCompile;
 
-/// Prints what `path` contains; with `kernels`, also builds the scene's kernels (the path
-/// tracer's and ReSTIR PT's with the given settings) on the device and prints their costs.
-pub fn info(path: &Path, kernels: Option<(RestirSettings, DeviceArgs)>) -> Result<()> {
-    let scene = load_with_warnings(path)?;
-    print_scene(path, &scene);
+/// Materials listed one per line; vertex colours can make thousands of variants.
+const MAX_LISTED_MATERIALS: usize = 64;
+
+/// Prints what `path` (loaded with `options`) contains and how long the load took; with
+/// `kernels`, also builds the scene's kernels (the path tracer's and ReSTIR PT's with the given
+/// settings) on the device and prints their costs.
+pub fn info(path: &Path, options: &LoadOptions, kernels: Option<(RestirSettings, DeviceArgs)>) -> Result<()> {
+    let start = std::time::Instant::now();
+    let scene = load_with_options(path, options)?;
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
+    print_scene(path, &scene, load_ms);
     if let Some((restir, device)) = kernels {
         let ctx = open_device(&device)?;
         let settings = RenderSettings {
@@ -49,10 +56,11 @@ fn print_kernels(label: &str, reports: &[KernelCompile]) {
     println!("  all kernels: {total:.0} ms");
 }
 
-fn print_scene(path: &Path, scene: &crate::scene::Scene) {
+fn print_scene(path: &Path, scene: &crate::scene::Scene, load_ms: f64) {
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());
+    println!("loaded in {load_ms:.0} ms, of which BVH build and emitter table {:.0} ms", scene.build_ms);
     println!("BVH nodes: {}", scene.nodes.len());
     println!(
         "emitters: {} triangles, power {:.4} (luminance W)",
@@ -61,19 +69,26 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene) {
     );
     println!("environment: {:?}", scene.environment.to_array());
     println!(
-        "bounds: {:?} .. {:?} (extent {:.4}), relative to the first camera at {:?} (world)",
+        "bounds: {:?} .. {:?} (extent {:.4}), relative to the origin at {:?} (world; the first camera, else the centre of the bounds)",
         lo.to_array(),
         hi.to_array(),
         scene.extent(),
         scene.origin.to_array()
     );
+    println!("punctual lights: {}", scene.lights.len());
+    for (i, l) in scene.lights.iter().enumerate() {
+        println!(
+            "  {i}: {:?} at {:?} along {:?}, intensity {:?}",
+            l.kind,
+            l.position.to_array(),
+            l.direction.to_array(),
+            l.intensity.to_array()
+        );
+    }
     println!("materials: {}", scene.materials.len());
-    for (m, name) in scene.materials.iter().zip(&scene.material_names) {
-        let used = scene
-            .triangles
-            .iter()
-            .filter(|t| scene.materials[t.material as usize] == *m)
-            .count();
+    let mut uses = vec![0usize; scene.materials.len()];
+    scene.triangles.iter().for_each(|t| uses[t.material as usize] += 1);
+    for ((m, name), used) in scene.materials.iter().zip(&scene.material_names).zip(uses).take(MAX_LISTED_MATERIALS) {
         println!(
             "  {name}: base {:?} metallic {} roughness {} transmission {} ior {} emission {:?}{} ({used} triangles)",
             m.base_color,
@@ -85,6 +100,9 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene) {
             if m.is_double_sided() { " double-sided" } else { "" }
         );
     }
+    if scene.materials.len() > MAX_LISTED_MATERIALS {
+        println!("  ... and {} more", scene.materials.len() - MAX_LISTED_MATERIALS);
+    }
     println!("cameras: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {
         let p: Vec3 = c.position;
@@ -95,5 +113,8 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene) {
             c.forward.to_array(),
             c.yfov.to_degrees()
         );
+        if let Some(a) = c.aspect_ratio {
+            println!("     aspect ratio {a:.4}");
+        }
     }
 }

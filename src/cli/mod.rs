@@ -23,7 +23,7 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use crate::scene::{load_scene, Scene};
+use crate::scene::{collapse_warnings, load_scene_reporting, LoadOptions, Scene};
 use crate::vk::{Context, ContextOptions};
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell.gltf";
@@ -54,11 +54,18 @@ pub fn bundled_file(relative: &Path) -> PathBuf {
 
 /// Loads a scene and prints the loader's warnings to stderr.
 pub fn load_with_warnings(path: &Path) -> Result<Scene> {
-    let scene = load_scene(path)?;
-    for w in &scene.warnings {
+    load_with_options(path, &LoadOptions::default())
+}
+
+/// Loads a scene with `options` and prints the loader's warnings to stderr, identical ones
+/// collapsed with their count; they are printed also when the load then fails.
+pub fn load_with_options(path: &Path, options: &LoadOptions) -> Result<Scene> {
+    let mut warnings = Vec::new();
+    let result = load_scene_reporting(path, options, &mut warnings);
+    for w in collapse_warnings(&warnings) {
         eprintln!("warning: {w}");
     }
-    Ok(scene)
+    result
 }
 
 pub fn open_device(args: &DeviceArgs) -> Result<Arc<Context>> {

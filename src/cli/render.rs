@@ -8,8 +8,9 @@ use std::sync::Arc;
 use anyhow::{bail, Context as _, Result};
 use serde::Serialize;
 
-use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
-use crate::image_io::{write_exr, write_png};
+use super::{finish_device, load_with_options, open_device, scene_path, DeviceArgs};
+use crate::image_io::{exposure_ev, write_exr, write_png_exposed, Exposure};
+use crate::scene::LoadOptions;
 use crate::render::{FrameStats, PathTracer, RenderSettings, Restir, RestirSettings, PASS_NAMES};
 use crate::scene::{camera_on_path, Scene};
 
@@ -27,8 +28,9 @@ pub struct RenderArgs {
     pub spp: Option<u32>,
     /// Every frame from --camera, averaged (ReSTIR PT's offline mode).
     pub static_camera: bool,
-    pub width: u32,
-    pub height: u32,
+    /// Image sides; a missing one follows the camera's aspect ratio (`Camera::image_size`).
+    pub width: Option<u32>,
+    pub height: Option<u32>,
     pub max_depth: u32,
     pub seed: u32,
     pub russian_roulette: bool,
@@ -41,6 +43,10 @@ pub struct RenderArgs {
     pub report: Option<PathBuf>,
     /// Write images with non-finite pixels (with a warning) instead of failing.
     pub allow_nonfinite: bool,
+    /// What to load besides the file: `--scene N`, `--env`.
+    pub load: LoadOptions,
+    /// Exposure of the PNG previews.
+    pub exposure: Exposure,
     pub device: DeviceArgs,
 }
 
@@ -163,22 +169,31 @@ fn frame_camera(args: &RenderArgs, frame: u32, cameras: usize) -> usize {
 
 pub fn render(args: RenderArgs) -> Result<()> {
     let path = scene_path(args.scene.as_deref());
-    let scene = load_with_warnings(&path)?;
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
+        bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
+    }
+    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // accessor counts, before reading vertices or building the BVH.
+    let ctx = open_device(&args.device)?;
+    let load = LoadOptions {
+        max_binding_bytes: Some(ctx.info.max_storage_buffer_range),
+        ..args.load.clone()
+    };
+    let scene = load_with_options(&path, &load)?;
     if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
         eprintln!(
             "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",
             path.display()
         );
     }
-    if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
-        bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
-    }
+    let camera = scene.cameras.get(args.camera).unwrap_or(&scene.cameras[0]);
+    let (width, height) = camera.image_size(args.width, args.height);
     let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
+        width,
+        height,
         spp: args.spp.unwrap_or(64),
         max_depth: args.max_depth,
         seed: args.seed,
@@ -205,12 +220,12 @@ pub fn render(args: RenderArgs) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     }
 
-    let ctx = open_device(&args.device)?;
     let outputs = Outputs {
         out: &out,
         png: &png,
         variance: args.variance.as_deref(),
         out_dir: args.out_dir.as_deref(),
+        exposure: args.exposure,
     };
     let report = match &args.method {
         Method::PathTracing => render_path_traced(&ctx, &scene, &path, &args, &settings, &outputs)?,
@@ -229,6 +244,7 @@ struct Outputs<'a> {
     png: &'a Path,
     variance: Option<&'a Path>,
     out_dir: Option<&'a Path>,
+    exposure: Exposure,
 }
 
 impl Outputs<'_> {
@@ -236,14 +252,18 @@ impl Outputs<'_> {
         if let Some(dir) = self.out_dir {
             let name = format!("frame_{frame:04}");
             write_exr(&dir.join(format!("{name}.exr")), image.width, image.height, &image.mean)?;
-            write_png(&dir.join(format!("{name}.png")), image)?;
+            write_png_exposed(&dir.join(format!("{name}.png")), image, exposure_ev(self.exposure, image))?;
         }
         Ok(())
     }
 
     fn write_final(&self, image: &crate::render::Image) -> Result<()> {
         write_exr(self.out, image.width, image.height, &image.mean)?;
-        write_png(self.png, image)?;
+        let ev = exposure_ev(self.exposure, image);
+        if self.exposure == Exposure::Auto {
+            eprintln!("PNG preview: exposure {ev:+.2} EV (automatic; --exposure EV sets it)");
+        }
+        write_png_exposed(self.png, image, ev)?;
         if let Some(v) = self.variance {
             write_exr(v, image.width, image.height, &image.variance)?;
         }

@@ -8,6 +8,7 @@ use ash::vk::PhysicalDeviceType;
 
 use crate::bsdf::lobe_weights;
 use crate::error::GpuError;
+use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
 use crate::vk::{Binding, Buffer, Context};
 
@@ -25,20 +26,31 @@ impl SceneGpu {
     pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
         let source = scene.source.display();
         let upload = |name: &str, r: Result<Buffer, GpuError>| r.with_context(|| format!("{source}: uploading {name}"));
+        let emitter_rows: Vec<Emitter> = scene.emitters.iter().copied().chain(scene.punctual_rows()).collect();
         let arrays = [
             std::mem::size_of_val(scene.triangles.as_slice()),
             std::mem::size_of_val(scene.nodes.as_slice()),
             std::mem::size_of_val(scene.materials.as_slice()),
-            std::mem::size_of_val(scene.emitters.as_slice()),
+            std::mem::size_of_val(emitter_rows.as_slice()),
         ];
         // Divergent uniform-buffer indexing serialises on GPUs; on llvmpipe it beats storage loads.
         let uniform = ctx.info.device_type == PhysicalDeviceType::CPU
             && arrays.iter().all(|&bytes| bytes as u64 <= ctx.info.max_uniform_buffer_range);
+        let placeholder = [Triangle::default()];
+        let no_material = [Material::default()];
         Ok(Self {
-            triangles: upload("triangles", Buffer::from_slice(ctx, "triangles", &scene.triangles))?,
+            // Vulkan has no empty buffers; a scene of points and lines alone has no triangles,
+            // and its BVH's one empty leaf never reads this placeholder.
+            triangles: upload(
+                "triangles",
+                Buffer::from_slice(ctx, "triangles", if scene.triangles.is_empty() { &placeholder } else { &scene.triangles }),
+            )?,
             nodes: upload("BVH nodes", Buffer::from_slice(ctx, "BVH nodes", &scene.nodes))?,
-            materials: upload("materials", Buffer::from_slice(ctx, "materials", &scene.materials))?,
-            emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &scene.emitters))?,
+            materials: upload(
+                "materials",
+                Buffer::from_slice(ctx, "materials", if scene.materials.is_empty() { &no_material } else { &scene.materials }),
+            )?,
+            emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &emitter_rows))?,
             uniform,
             defines: scene_defines(scene, uniform),
         })
@@ -72,14 +84,18 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("BSDF_DIELECTRIC", flag(used(|w| w.2))),
         ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
+        ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
     ];
     if uniform {
         defines.extend([
-            ("SCENE_TRIANGLE_COUNT", scene.triangles.len().to_string()),
+            ("SCENE_TRIANGLE_COUNT", scene.triangles.len().max(1).to_string()),
             ("SCENE_NODE_COUNT", scene.nodes.len().to_string()),
-            ("SCENE_MATERIAL_COUNT", scene.materials.len().to_string()),
-            ("SCENE_EMITTER_SLOTS", scene.emitters.len().max(1).to_string()),
+            ("SCENE_MATERIAL_COUNT", scene.materials.len().max(1).to_string()),
+            (
+                "SCENE_EMITTER_SLOTS",
+                (scene.emitters.len() + PUNCTUAL_ROWS * scene.lights.len()).max(1).to_string(),
+            ),
         ]);
     }
     defines

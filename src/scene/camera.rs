@@ -4,6 +4,15 @@ use glam::{Mat4, Vec3};
 
 use crate::gpu_types::FrameParams;
 
+/// The side of an image whose size neither the command line nor the camera sets.
+pub const DEFAULT_IMAGE_SIDE: u32 = 256;
+
+/// From the scene's centre towards the default camera: normalize(0, 1, 2).
+pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(0.0, 0.447_213_6, 0.894_427_2);
+
+/// Vertical field of view of the default camera (45 degrees).
+pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Camera {
     pub name: String,
@@ -13,6 +22,8 @@ pub struct Camera {
     pub right: Vec3,
     /// Vertical field of view in radians.
     pub yfov: f32,
+    /// The glTF camera's `aspectRatio` (width / height), if it gives one.
+    pub aspect_ratio: Option<f32>,
 }
 
 impl Camera {
@@ -30,7 +41,21 @@ impl Camera {
             up,
             right,
             yfov,
+            aspect_ratio: None,
         }
+    }
+
+    /// The camera of a scene that has none: it looks at the centre of the bounds `(lo, hi)`
+    /// along -[`DEFAULT_VIEW_DIRECTION`] (from the +Z side, glTF's front, 26.6 degrees above the
+    /// horizon so that flat ground is seen), from the distance at which their bounding sphere just
+    /// fills a vertical field of view of [`DEFAULT_YFOV`] (r / sin(yfov / 2) from the centre).
+    pub fn framing(bounds: (Vec3, Vec3)) -> Camera {
+        let (lo, hi) = bounds;
+        let centre = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(1e-6);
+        let distance = radius / (0.5 * DEFAULT_YFOV).sin();
+        let eye = centre + DEFAULT_VIEW_DIRECTION * distance;
+        Camera::look_at("default camera", eye, centre, Vec3::Y, DEFAULT_YFOV)
     }
 
     pub fn look_at(name: &str, eye: Vec3, target: Vec3, up: Vec3, yfov: f32) -> Camera {
@@ -43,12 +68,40 @@ impl Camera {
             up: right.cross(forward),
             right,
             yfov,
+            aspect_ratio: None,
+        }
+    }
+
+    /// tan(vertical field of view / 2) for an image of `width` x `height`. The camera's view is
+    /// fitted into the image: an image wider than the camera's `aspect_ratio` keeps yfov and shows
+    /// more at the sides; a narrower one widens the vertical field of view until the camera's
+    /// horizontal field of view (yfov and `aspect_ratio`) fits, so nothing of the intended view
+    /// is cropped. Without `aspect_ratio`, yfov is kept (glTF: the viewport's ratio is used).
+    pub fn tan_half_fov(&self, width: u32, height: u32) -> f32 {
+        let tan_half = (0.5 * self.yfov).tan();
+        let image_aspect = width as f32 / height as f32;
+        match self.aspect_ratio {
+            Some(a) if image_aspect < a => tan_half * a / image_aspect,
+            _ => tan_half,
+        }
+    }
+
+    /// The image size for the requested sides: both given, they are used; one given, the other
+    /// follows the camera's `aspect_ratio` (without one, it is [`DEFAULT_IMAGE_SIDE`]); none
+    /// given, [`DEFAULT_IMAGE_SIDE`] squared.
+    pub fn image_size(&self, width: Option<u32>, height: Option<u32>) -> (u32, u32) {
+        let side = |x: f32| (x.round() as u32).max(1);
+        match (width, height, self.aspect_ratio) {
+            (Some(w), Some(h), _) => (w, h),
+            (Some(w), None, Some(a)) => (w, side(w as f32 / a)),
+            (None, Some(h), Some(a)) => (side(h as f32 * a), h),
+            (w, h, _) => (w.unwrap_or(DEFAULT_IMAGE_SIDE), h.unwrap_or(DEFAULT_IMAGE_SIDE)),
         }
     }
 
     /// Writes the camera rows of the frame parameters for an image of `width` x `height`.
     pub fn fill_params(&self, params: &mut FrameParams, width: u32, height: u32) {
-        let tan_half = (0.5 * self.yfov).tan();
+        let tan_half = self.tan_half_fov(width, height);
         params.cam_position = self.position.extend(tan_half).into();
         params.cam_right = self.right.extend(width as f32 / height as f32).into();
         params.cam_up = self.up.extend(0.0).into();
@@ -58,7 +111,7 @@ impl Camera {
     /// Twin of GLSL `camera_ray_dir` (glsl/camera.glsl): direction through image point (px, py),
     /// in pixels from the top-left corner.
     pub fn ray_dir(&self, px: f32, py: f32, width: u32, height: u32) -> Vec3 {
-        let tan_half = (0.5 * self.yfov).tan();
+        let tan_half = self.tan_half_fov(width, height);
         let aspect = width as f32 / height as f32;
         let x = (2.0 * px / width as f32 - 1.0) * tan_half * aspect;
         let y = (1.0 - 2.0 * py / height as f32) * tan_half;

@@ -1,57 +1,112 @@
 //! glTF 2.0 (.gltf and .glb) to [`Scene`]. The data is checked, not only the JSON: every problem
 //! is an error or a warning that names the file.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 use glam::{DMat4, DVec3, Vec3};
 
-use super::{Camera, Scene, SceneParts};
-use crate::gpu_types::{Material, Triangle, MATERIAL_DOUBLE_SIDED, NO_EMITTER};
+use super::gltf_json::{check_external_buffers, read_raw, Instancing};
+use super::{Camera, PunctualLight, Scene, SceneParts};
+use crate::gpu_types::{Material, Triangle};
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
-const MAX_NODE_DEPTH: usize = 256;
+pub(super) const MAX_NODE_DEPTH: usize = 256;
 /// Node instances visited; guards against exponential instancing blow-ups.
-const MAX_NODE_INSTANCES: usize = 1 << 20;
-const MAX_TRIANGLES: usize = 1 << 26;
+pub(super) const MAX_NODE_INSTANCES: usize = 1 << 20;
+pub(super) const MAX_TRIANGLES: usize = 1 << 26;
 
-struct Loader<'a> {
-    path: &'a Path,
-    doc: &'a gltf::Document,
-    buffers: &'a [gltf::buffer::Data],
-    triangles: Vec<Triangle>,
-    materials: Vec<Material>,
-    material_names: Vec<String>,
+pub(super) struct Loader<'a> {
+    pub(super) path: &'a Path,
+    pub(super) doc: &'a gltf::Document,
+    pub(super) buffers: &'a [gltf::buffer::Data],
+    pub(super) instancing: &'a HashMap<usize, Instancing>,
+    pub(super) triangles: Vec<Triangle>,
+    pub(super) materials: Vec<Material>,
+    pub(super) material_names: Vec<String>,
+    /// Whether each material is `KHR_materials_unlit` (its emission is its base colour).
+    pub(super) unlit: Vec<bool>,
     /// Index of the glTF default material in `materials`, added on first use.
-    default_material: Option<u32>,
-    cameras: Vec<Camera>,
-    /// Mesh instances with their world transforms, added once the origin is known.
+    pub(super) default_material: Option<u32>,
+    /// Materials multiplied by a COLOR_0 colour: (material, colour bits) to the variant's index.
+    pub(super) colour_variants: HashMap<(u32, [u32; 3]), u32>,
+    pub(super) cameras: Vec<Camera>,
+    /// Punctual lights; their positions are set relative to `origin` once the walk is done.
+    pub(super) lights: Vec<PunctualLight>,
+    /// World positions (f64) of `lights`, one per light.
+    pub(super) light_positions: Vec<DVec3>,
+    /// Mesh instances with their world transforms (f64), added once the origin is known.
     instances: Vec<(gltf::Mesh<'a>, DMat4)>,
-    /// World position of the scene's coordinate origin: the first camera (see `walk_nodes`).
-    origin: DVec3,
-    warnings: Vec<String>,
-    degenerate: usize,
-    degenerate_emitters: usize,
+    /// World position of the scene coordinates' origin (see `walk_nodes`).
+    pub(super) origin: DVec3,
+    pub(super) warnings: Vec<String>,
+    pub(super) counts: MeshCounts,
 }
 
-fn problem(path: &Path, msg: impl std::fmt::Display) -> anyhow::Error {
+/// Things counted over the whole file and reported once each.
+#[derive(Default)]
+pub(super) struct MeshCounts {
+    pub degenerate: usize,
+    pub degenerate_emitters: usize,
+    pub points_or_lines: usize,
+    pub colour_varying: usize,
+    pub instances: usize,
+    /// World-space bounds of the skipped points and lines (frame a scene made only of them).
+    pub skipped_bounds: Option<(Vec3, Vec3)>,
+}
+
+pub(super) fn problem(path: &Path, msg: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("{}: {msg}", path.display())
 }
 
-/// Loads a glTF or GLB file. Errors are one line naming the file and the problem.
+/// What to take from a file besides its own content.
+#[derive(Debug, Clone, Default)]
+pub struct LoadOptions {
+    /// The glTF scene to load (index into `scenes`); none: the file's default scene, else the first.
+    pub scene: Option<usize>,
+    /// An environment that replaces the file's (and the default one).
+    pub environment: Option<Vec3>,
+    /// The device's per-binding limit (bytes): a file whose accessor counts promise more
+    /// triangles than one binding holds fails before its vertices are read.
+    pub max_binding_bytes: Option<u64>,
+}
+
+/// Loads a glTF or GLB file. Errors are one line naming the file and the problem; warnings are
+/// in `Scene::warnings`.
 pub fn load_scene(path: &Path) -> Result<Scene> {
+    let mut warnings = Vec::new();
+    load_scene_reporting(path, &LoadOptions::default(), &mut warnings)
+}
+
+/// Loads a glTF or GLB file with `options`; every warning goes to `warnings`, also when the load
+/// then fails (and, on success, to `Scene::warnings` as well).
+pub fn load_scene_reporting(path: &Path, options: &LoadOptions, warnings: &mut Vec<String>) -> Result<Scene> {
     let bytes = std::fs::read(path).map_err(|e| problem(path, format!("cannot read the file: {e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
-    load_scene_from_bytes(&bytes, Some(&base), path)
+    load_bytes_reporting(&bytes, Some(&base), path, options, warnings)
 }
 
 /// Loads glTF or GLB bytes; external buffers resolve against `base` (none: only embedded data).
 /// `path` names the input in messages.
 pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> Result<Scene> {
-    let gltf = parse_gltf(bytes, path)?;
-    let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
+    load_bytes_reporting(bytes, base, path, &LoadOptions::default(), &mut Vec::new())
+}
+
+fn load_bytes_reporting(
+    bytes: &[u8],
+    base: Option<&Path>,
+    path: &Path,
+    options: &LoadOptions,
+    warnings: &mut Vec<String>,
+) -> Result<Scene> {
+    let mut warn = |w: String| warnings.push(format!("{}: {w}", path.display()));
+    let raw = read_raw(bytes, path, &mut warn)?;
+    check_external_buffers(&raw.json, base, path)?;
+    let document = parse_gltf(raw.json, path)?;
+    let buffers = gltf::import_buffers(&document, base, raw.blob)
         .map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
-    for (i, (data, buffer)) in buffers.iter().zip(gltf.document.buffers()).enumerate() {
+    for (i, (data, buffer)) in buffers.iter().zip(document.buffers()).enumerate() {
         if data.len() < buffer.length() {
             bail!(problem(
                 path,
@@ -61,28 +116,31 @@ pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> 
     }
     let mut loader = Loader {
         path,
-        doc: &gltf.document,
+        doc: &document,
         buffers: &buffers,
+        instancing: &raw.instancing,
         triangles: Vec::new(),
         materials: Vec::new(),
         material_names: Vec::new(),
+        unlit: Vec::new(),
         default_material: None,
+        colour_variants: HashMap::new(),
         cameras: Vec::new(),
+        lights: Vec::new(),
+        light_positions: Vec::new(),
         instances: Vec::new(),
         origin: DVec3::ZERO,
         warnings: Vec::new(),
-        degenerate: 0,
-        degenerate_emitters: 0,
+        counts: MeshCounts::default(),
     };
-    loader.load_materials()?;
-    let scene = gltf.document.default_scene().or_else(|| gltf.document.scenes().next());
-    let scene = scene.ok_or_else(|| problem(path, "the file has no scene"))?;
-    loader.walk_nodes(&scene)?;
-    let environment = scene_environment(path, &scene, &gltf.document)?;
-    loader.finish(environment)
+    let result = loader.run(options);
+    warnings.append(&mut loader.warnings);
+    let mut scene = result?;
+    scene.warnings = warnings.clone();
+    Ok(scene)
 }
 
-fn invalid_gltf(path: &Path, e: gltf::Error) -> anyhow::Error {
+fn invalid_gltf(path: &Path, e: impl std::fmt::Display) -> anyhow::Error {
     let e = e.to_string();
     // The gltf crate prefixes validation errors itself; JSON errors need the context.
     problem(
@@ -95,35 +153,11 @@ fn invalid_gltf(path: &Path, e: gltf::Error) -> anyhow::Error {
     )
 }
 
-/// GLB files start with this magic, then a version and the total length (12 bytes).
-const GLB_MAGIC: &[u8; 4] = b"glTF";
-const GLB_HEADER_BYTES: usize = 12;
-
-/// Parses and validates glTF or GLB. Two inputs that make the gltf crate panic (found by
-/// fuzzing) are checked here first: a GLB header whose length is shorter than the header itself
-/// (an overflowing subtraction), and a primitive whose POSITION accessor does not exist (which
-/// gltf-json's validation indexes unchecked).
-fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
+/// Validates the JSON into a document. A primitive whose POSITION accessor does not exist makes
+/// gltf-json's validation index out of bounds (found by fuzzing), so it is checked first.
+fn parse_gltf(json: serde_json::Value, path: &Path) -> Result<gltf::Document> {
     use gltf::json::{mesh::Semantic, validation::Checked};
-    if bytes.starts_with(GLB_MAGIC) {
-        let declared = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
-        match declared {
-            Some(length) if (GLB_HEADER_BYTES..=bytes.len()).contains(&length) => {}
-            Some(length) => bail!(problem(
-                path,
-                format!(
-                    "truncated or corrupt GLB: the header declares {length} bytes, the file has {}",
-                    bytes.len()
-                )
-            )),
-            None => bail!(problem(
-                path,
-                format!("truncated GLB: {} bytes, less than its 12-byte header", bytes.len())
-            )),
-        }
-    }
-    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| invalid_gltf(path, e))?;
-    let root = unchecked.document.into_json();
+    let root: gltf::json::Root = serde_json::from_value(json).map_err(|e| invalid_gltf(path, e))?;
     for (m, mesh) in root.meshes.iter().enumerate() {
         for primitive in &mesh.primitives {
             if let Some(index) = primitive.attributes.get(&Checked::Valid(Semantic::Positions)) {
@@ -140,11 +174,7 @@ fn parse_gltf(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
             }
         }
     }
-    let document = gltf::Document::from_json(root).map_err(|e| invalid_gltf(path, e))?;
-    Ok(gltf::Gltf {
-        document,
-        blob: unchecked.blob,
-    })
+    gltf::Document::from_json(root).map_err(|e| invalid_gltf(path, e))
 }
 
 /// The constant environment: `"environment": [r, g, b]` in the scene's extras, else in the
@@ -173,98 +203,39 @@ fn scene_environment(path: &Path, scene: &gltf::Scene, doc: &gltf::Document) -> 
 }
 
 impl<'a> Loader<'a> {
-    fn warn(&mut self, msg: impl std::fmt::Display) {
+    pub(super) fn warn(&mut self, msg: impl std::fmt::Display) {
         self.warnings.push(format!("{}: {msg}", self.path.display()));
     }
 
-    fn load_materials(&mut self) -> Result<()> {
+    fn run(&mut self, options: &LoadOptions) -> Result<Scene> {
+        self.load_materials()?;
         let doc = self.doc;
-        for m in doc.materials() {
-            let name = m
-                .name()
-                .map(str::to_string)
-                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
-            let material = self.convert_material(&m, &name)?;
-            self.materials.push(material);
-            self.material_names.push(name);
+        let scene = match options.scene {
+            Some(i) => doc.scenes().nth(i).ok_or_else(|| {
+                problem(self.path, format!("--scene {i} does not exist; the file has {} scene(s)", doc.scenes().count()))
+            })?,
+            None => doc
+                .default_scene()
+                .or_else(|| doc.scenes().next())
+                .ok_or_else(|| problem(self.path, "the file has no scene"))?,
+        };
+        if let Some(limit) = options.max_binding_bytes {
+            self.check_binding_budget(&scene, limit)?;
         }
-        Ok(())
+        self.walk_nodes(&scene)?;
+        // --env replaces the file's environment; the scene's extras come before the root's.
+        let environment = match options.environment {
+            Some(env) => env,
+            None => scene_environment(self.path, &scene, doc)?,
+        };
+        self.finish(environment)
     }
 
-    fn convert_material(&mut self, m: &gltf::Material, name: &str) -> Result<Material> {
-        let pbr = m.pbr_metallic_roughness();
-        let ignored_textures = [
-            ("base colour", pbr.base_color_texture().is_some()),
-            ("metallic-roughness", pbr.metallic_roughness_texture().is_some()),
-            ("normal", m.normal_texture().is_some()),
-            ("occlusion", m.occlusion_texture().is_some()),
-            ("emissive", m.emissive_texture().is_some()),
-            ("transmission", m.transmission().is_some_and(|t| t.transmission_texture().is_some())),
-        ];
-        for (kind, present) in ignored_textures {
-            if present {
-                self.warn(format!(
-                    "{name}: {kind} texture ignored (textures are not supported; factors are used)"
-                ));
-            }
-        }
-        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
-            self.warn(format!("{name}: alpha mode {:?} ignored (rendered opaque)", m.alpha_mode()));
-        }
-        if m.volume().is_some() {
-            self.warn(format!("{name}: KHR_materials_volume ignored (no participating media)"));
-        }
-        let base = pbr.base_color_factor();
-        let strength = m.emissive_strength().unwrap_or(1.0);
-        let emissive = m.emissive_factor();
-        let transmission = m.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0);
-        let ior = m.ior().unwrap_or(1.5);
-        let checks = [
-            (
-                "baseColorFactor",
-                base[..3].iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)),
-            ),
-            ("metallicFactor", (0.0..=1.0).contains(&pbr.metallic_factor())),
-            ("roughnessFactor", (0.0..=1.0).contains(&pbr.roughness_factor())),
-            ("emissiveFactor", emissive.iter().all(|v| v.is_finite() && *v >= 0.0)),
-            ("emissiveStrength", strength.is_finite() && strength >= 0.0),
-            ("transmissionFactor", (0.0..=1.0).contains(&transmission)),
-            // Within rounding below 1 is index-matched (docs/materials.md), not an error.
-            ("ior", ior.is_finite() && (ior >= 1.0 || crate::bsdf::index_matched(ior))),
-        ];
-        if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
-            bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));
-        }
-        Ok(Material {
-            base_color: [base[0], base[1], base[2]],
-            metallic: pbr.metallic_factor(),
-            emission: (Vec3::from(emissive) * strength).into(),
-            roughness: pbr.roughness_factor(),
-            transmission,
-            ior,
-            flags: if m.double_sided() { MATERIAL_DOUBLE_SIDED } else { 0 },
-            pad: 0,
-        })
-    }
-
-    fn default_material(&mut self) -> u32 {
-        *self.default_material.get_or_insert_with(|| {
-            // glTF's default material: white, metallic 1, roughness 1.
-            self.materials.push(Material {
-                base_color: [1.0; 3],
-                metallic: 1.0,
-                roughness: 1.0,
-                ior: 1.5,
-                ..Default::default()
-            });
-            self.material_names.push("glTF default material".to_string());
-            (self.materials.len() - 1) as u32
-        })
-    }
-
-    /// Walks the hierarchy in f64 and re-centres the scene on its first camera: geometry is
-    /// uploaded in f32 camera-relative coordinates, so a scene far from the world origin keeps
-    /// the precision it has near the camera (as large-world engines do).
+    /// Walks the hierarchy in f64 and re-centres the scene before rounding to f32: on its first
+    /// camera, so that geometry is uploaded in camera-relative coordinates and a scene far from
+    /// the world origin keeps the precision it has near the camera (as large-world engines do);
+    /// a scene without a camera on the centre of its vertices' world bounds, where the default
+    /// camera (`finish`) looks. `origin` holds the chosen world position, exact in f64.
     fn walk_nodes(&mut self, scene: &gltf::Scene<'a>) -> Result<()> {
         let mut stack: Vec<(gltf::Node, DMat4, usize)> = scene.nodes().map(|n| (n, DMat4::IDENTITY, 0)).collect();
         stack.reverse();
@@ -277,7 +248,7 @@ impl<'a> Loader<'a> {
                     format!("node hierarchy deeper than {MAX_NODE_DEPTH} levels (a cycle?)")
                 ));
             }
-            if visited > MAX_NODE_INSTANCES {
+            if visited + self.counts.instances > MAX_NODE_INSTANCES {
                 bail!(problem(self.path, format!("more than {MAX_NODE_INSTANCES} node instances")));
             }
             let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
@@ -286,16 +257,35 @@ impl<'a> Loader<'a> {
                 bail!(problem(self.path, format!("node {} has a non-finite transform", node.index())));
             }
             if let Some(mesh) = node.mesh() {
-                self.instances.push((mesh, world));
+                match self.instancing.get(&node.index()).copied() {
+                    Some(inst) => {
+                        for instance in self.instance_transforms(&node, &inst)? {
+                            self.instances.push((mesh.clone(), world * instance));
+                        }
+                    }
+                    None => self.instances.push((mesh, world)),
+                }
             }
             if let Some(camera) = node.camera() {
                 self.add_camera(&camera, &node, &world);
             }
+            if let Some(light) = node.light() {
+                self.add_light(&light, &node, &world)?;
+            }
             let children: Vec<_> = node.children().collect();
             stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
         }
+        if self.cameras.is_empty() {
+            if let Some((lo, hi)) = self.vertex_bounds(&self.instances) {
+                self.origin = 0.5 * (lo + hi);
+            }
+        }
         for (mesh, world) in std::mem::take(&mut self.instances) {
             self.add_mesh(&mesh, &world)?;
+        }
+        let origin = self.origin;
+        for (light, world) in self.lights.iter_mut().zip(&self.light_positions) {
+            light.position = (*world - origin).as_vec3();
         }
         Ok(())
     }
@@ -313,7 +303,9 @@ impl<'a> Loader<'a> {
                 }
                 let mut relative = *world;
                 relative.w_axis -= self.origin.extend(0.0);
-                self.cameras.push(Camera::from_transform(name, &relative.as_mat4(), p.yfov()));
+                let mut c = Camera::from_transform(name, &relative.as_mat4(), p.yfov());
+                c.aspect_ratio = p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0);
+                self.cameras.push(c);
             }
             gltf::camera::Projection::Perspective(p) => {
                 self.warn(format!("camera on node {} has an invalid yfov {}; ignored", node.index(), p.yfov()))
@@ -322,152 +314,84 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn add_mesh(&mut self, mesh: &gltf::Mesh, world: &DMat4) -> Result<()> {
-        // A mirroring transform flips the winding, and so which face is the front.
-        let flip = world.determinant() < 0.0;
-        for prim in mesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                self.warn(format!(
-                    "mesh {}: primitive mode {:?} ignored (only triangles are rendered)",
-                    mesh.index(),
-                    prim.mode()
-                ));
-                continue;
+    fn finish(&mut self, environment: Vec3) -> Result<Scene> {
+        let this = self;
+        let skipped_bounds = this.counts.skipped_bounds;
+        this.report_counts();
+        let bounds = match skipped_bounds {
+            Some(b) if this.triangles.is_empty() => {
+                this.warn("the scene has no triangles, only points or lines: the image shows the environment alone");
+                b
             }
-            self.check_accessor_types(mesh, &prim)?;
-            let buffers = self.buffers;
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| {
-                    problem(
-                        self.path,
-                        format!("mesh {}: POSITION data is missing or does not fit its buffer", mesh.index()),
-                    )
-                })?
-                .map(Vec3::from)
-                .collect();
-            if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-                bail!(problem(
-                    self.path,
-                    format!("mesh {}: vertex {i} has a NaN or infinite position", mesh.index())
-                ));
-            }
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(idx) => idx.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
-            };
-            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-                bail!(problem(
-                    self.path,
-                    format!("mesh {}: index {bad} is out of range ({} vertices)", mesh.index(), positions.len())
-                ));
-            }
-            if !indices.len().is_multiple_of(3) {
-                self.warn(format!("mesh {}: {} trailing indices ignored", mesh.index(), indices.len() % 3));
-            }
-            let material = match prim.material().index() {
-                Some(i) => i as u32,
-                None => self.default_material(),
-            };
-            let emissive = Vec3::from(self.materials[material as usize].emission).max_element() > 0.0;
-            for tri in indices.chunks_exact(3) {
-                let [a, b, c] = [0, 1, 2].map(|k| world.transform_point3(positions[tri[k] as usize].as_dvec3()) - self.origin);
-                let (b, c) = if flip { (c, b) } else { (b, c) };
-                let (e1, e2) = ((b - a).as_vec3(), (c - a).as_vec3());
-                let a = a.as_vec3();
-                let area2 = e1.cross(e2).length();
-                // Degenerate triangles carry no area: they cannot be hit or emit, and break normals.
-                if !(area2 > 1e-12 * (e1.length_squared() + e2.length_squared()).max(f32::MIN_POSITIVE)) || !area2.is_finite() {
-                    self.degenerate += 1;
-                    self.degenerate_emitters += emissive as usize;
-                    continue;
-                }
-                if self.triangles.len() >= MAX_TRIANGLES {
-                    bail!(problem(self.path, format!("more than {MAX_TRIANGLES} triangles")));
-                }
-                self.triangles.push(Triangle {
-                    v0: a.into(),
-                    material,
-                    e1: e1.into(),
-                    emitter: NO_EMITTER,
-                    e2: e2.into(),
-                    pad: 0,
-                });
-            }
-        }
-        Ok(())
-    }
-
-    /// The spec's accessor types for positions (float VEC3) and indices (unsigned SCALAR); the
-    /// gltf crate's readers assume them (an index accessor of floats hits `unreachable!`).
-    fn check_accessor_types(&self, mesh: &gltf::Mesh, prim: &gltf::Primitive) -> Result<()> {
-        use gltf::accessor::{DataType, Dimensions};
-        if let Some(p) = prim.get(&gltf::Semantic::Positions) {
-            if p.data_type() != DataType::F32 || p.dimensions() != Dimensions::Vec3 {
-                bail!(problem(
-                    self.path,
-                    format!(
-                        "mesh {}: POSITION must be float VEC3, not {:?} {:?}",
-                        mesh.index(),
-                        p.data_type(),
-                        p.dimensions()
-                    )
-                ));
-            }
-        }
-        if let Some(i) = prim.indices() {
-            let unsigned = matches!(i.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
-            if !unsigned || i.dimensions() != Dimensions::Scalar {
-                bail!(problem(
-                    self.path,
-                    format!(
-                        "mesh {}: indices must be unsigned SCALAR, not {:?} {:?}",
-                        mesh.index(),
-                        i.data_type(),
-                        i.dimensions()
-                    )
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    fn finish(mut self, environment: Vec3) -> Result<Scene> {
-        if self.degenerate > 0 {
-            let n = self.degenerate;
-            self.warn(format!("{n} degenerate (zero-area) triangle(s) dropped"));
-        }
-        if self.degenerate_emitters > 0 {
-            let n = self.degenerate_emitters;
-            self.warn(format!("{n} zero-area emitter triangle(s) dropped"));
-        }
-        if self.triangles.is_empty() {
-            bail!(problem(self.path, "the scene has no renderable triangles"));
-        }
-        let has_emitter = self
+            _ if this.triangles.is_empty() => bail!(problem(this.path, "the scene has no renderable triangles")),
+            _ => triangle_bounds(&this.triangles),
+        };
+        let has_emitter = this
             .triangles
             .iter()
-            .any(|t| Vec3::from(self.materials[t.material as usize].emission).max_element() > 0.0);
-        if !has_emitter && environment.max_element() <= 0.0 {
-            bail!(problem(
-                self.path,
-                "the scene has no light: no emissive triangle and no environment"
+            .any(|t| Vec3::from(this.materials[t.material as usize].emission).max_element() > 0.0);
+        let mut environment = environment;
+        if !has_emitter && this.lights.is_empty() && environment.max_element() <= 0.0 {
+            environment = DEFAULT_ENVIRONMENT;
+            this.warn(format!(
+                "the scene has no light (no emissive triangle, punctual light or environment): using a uniform environment of radiance {}",
+                DEFAULT_ENVIRONMENT.x
             ));
         }
-        if self.cameras.is_empty() {
-            bail!(problem(self.path, "the scene has no perspective camera"));
+        if this.cameras.is_empty() {
+            let camera = Camera::framing(bounds);
+            this.warn(format!(
+                "the scene has no perspective camera: using a default one at {:?} looking at the centre of the bounds from +Z and 26.6 deg above, yfov {:.0} deg, framing their bounding sphere",
+                camera.position.to_array(),
+                camera.yfov.to_degrees()
+            ));
+            this.cameras.push(camera);
         }
+        let origin = this.origin;
         let mut scene = Scene::build(SceneParts {
-            source: self.path.to_path_buf(),
-            triangles: self.triangles,
-            materials: self.materials,
-            material_names: self.material_names,
+            source: this.path.to_path_buf(),
+            triangles: std::mem::take(&mut this.triangles),
+            materials: std::mem::take(&mut this.materials),
+            material_names: std::mem::take(&mut this.material_names),
             environment,
-            cameras: self.cameras,
-            warnings: self.warnings,
+            cameras: std::mem::take(&mut this.cameras),
+            lights: std::mem::take(&mut this.lights),
+            warnings: Vec::new(),
         });
-        scene.origin = self.origin;
+        scene.origin = origin;
         Ok(scene)
     }
+
+    /// One warning per kind of thing dropped, with its count over the whole file.
+    fn report_counts(&mut self) {
+        let c = std::mem::take(&mut self.counts);
+        if c.degenerate > 0 {
+            self.warn(format!("{} degenerate (zero-area) triangle(s) dropped", c.degenerate));
+        }
+        if c.degenerate_emitters > 0 {
+            self.warn(format!("{} zero-area emitter triangle(s) dropped", c.degenerate_emitters));
+        }
+        if c.points_or_lines > 0 {
+            self.warn(format!(
+                "{} primitive(s) of points or lines skipped (only triangles, strips and fans are rendered)",
+                c.points_or_lines
+            ));
+        }
+        if c.colour_varying > 0 {
+            self.warn(format!(
+                "COLOR_0 varies within {} triangle(s): each triangle takes the mean of its vertices' colours",
+                c.colour_varying
+            ));
+        }
+    }
+}
+
+/// The environment of a scene with no light at all.
+pub const DEFAULT_ENVIRONMENT: Vec3 = Vec3::ONE;
+
+fn triangle_bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
+    triangles.iter().flat_map(Triangle::vertices).fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
 }

@@ -1,16 +1,24 @@
 //! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
 
 mod camera;
+mod gltf_budget;
+mod gltf_json;
 mod gltf_loader;
+mod gltf_material;
+mod gltf_mesh;
+mod punctual;
 
-pub use camera::{camera_on_path, Camera};
-pub use gltf_loader::{load_scene, load_scene_from_bytes};
+pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
+pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, LoadOptions, DEFAULT_ENVIRONMENT};
+pub use gltf_material::spec_gloss_to_metal_rough;
+pub use gltf_mesh::triangle_indices;
+pub use punctual::{PunctualKind, PunctualLight};
 
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
 use crate::bvh::Bvh;
-use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER};
+use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::build_alias_table;
 
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
@@ -28,15 +36,21 @@ pub struct Scene {
     pub environment: Vec3,
     pub env_select_prob: f32,
     pub cameras: Vec<Camera>,
+    /// `KHR_lights_punctual` lights in scene coordinates (like the triangles: relative to
+    /// [`Scene::origin`]).
+    pub lights: Vec<PunctualLight>,
     /// Bounds of the triangles in scene coordinates.
     pub bounds: (Vec3, Vec3),
-    /// World position of the scene coordinates' origin. Loaded scenes are re-centred on their
-    /// first camera in f64 before rounding to f32 (camera-relative coordinates), so precision
-    /// near the camera does not depend on where the scene sits in the world; 0 for scenes built
-    /// directly.
+    /// World position of the scene coordinates' origin. Loaded scenes are re-centred in f64
+    /// before rounding to f32, so precision near the camera does not depend on where the scene
+    /// sits in the world: on their first camera (camera-relative coordinates), or, in a scene
+    /// without one, on the centre of its vertices' world bounds, which the default camera looks
+    /// at. 0 for scenes built directly.
     pub origin: DVec3,
     /// Things the loader dropped or ignored; each line names the file.
     pub warnings: Vec<String>,
+    /// Wall time of the BVH build and emitter table (ms).
+    pub build_ms: f64,
 }
 
 pub fn luminance(c: Vec3) -> f32 {
@@ -51,6 +65,7 @@ pub struct SceneParts {
     pub material_names: Vec<String>,
     pub environment: Vec3,
     pub cameras: Vec<Camera>,
+    pub lights: Vec<PunctualLight>,
     pub warnings: Vec<String>,
 }
 
@@ -58,6 +73,7 @@ impl Scene {
     /// Builds the BVH (reordering triangles) and the emitter table. Triangles must be
     /// non-degenerate and finite; the loader guarantees it.
     pub fn build(parts: SceneParts) -> Scene {
+        let start = std::time::Instant::now();
         let bvh = Bvh::build(&parts.triangles);
         let mut triangles: Vec<Triangle> = bvh.order.iter().map(|&i| parts.triangles[i as usize]).collect();
         let mut emitter_tris = Vec::new();
@@ -73,6 +89,14 @@ impl Scene {
                 powers.push(power);
             }
         }
+        let triangle_power = powers.iter().fold(0.0, |a, p| a + p);
+        // Punctual lights join the alias table after the triangles, chosen by power too.
+        let bounds = (Vec3::from(bvh.nodes[0].lo), Vec3::from(bvh.nodes[0].hi));
+        let scene_radius = if triangles.is_empty() { 1.0 } else { 0.5 * (bounds.1 - bounds.0).length() };
+        for (k, light) in parts.lights.iter().enumerate() {
+            emitter_tris.push(PUNCTUAL_LIGHT_BIT | k as u32);
+            powers.push(light.power(scene_radius).max(f32::MIN_POSITIVE));
+        }
         let emitters = if emitter_tris.is_empty() {
             Vec::new()
         } else {
@@ -85,6 +109,7 @@ impl Scene {
             (true, false) => ENV_SELECT_PROB_WITH_EMITTERS,
         };
         let root = bvh.nodes[0];
+        let triangles_empty = triangles.is_empty();
         Scene {
             source: parts.source,
             triangles,
@@ -92,17 +117,52 @@ impl Scene {
             materials: parts.materials,
             material_names: parts.material_names,
             emitters,
-            emitter_power: powers.iter().fold(0.0, |a, p| a + p),
+            emitter_power: triangle_power,
             environment: parts.environment,
             env_select_prob,
             cameras: parts.cameras,
-            bounds: (Vec3::from(root.lo), Vec3::from(root.hi)),
+            lights: parts.lights,
+            // A scene of points and lines alone has no triangles (and an empty root box).
+            bounds: if triangles_empty {
+                (Vec3::ZERO, Vec3::ZERO)
+            } else {
+                (Vec3::from(root.lo), Vec3::from(root.hi))
+            },
             origin: DVec3::ZERO,
             warnings: parts.warnings,
+            build_ms: start.elapsed().as_secs_f64() * 1e3,
         }
+    }
+
+    /// The probability that light selection (given it chose no environment) picks punctual light
+    /// `k`: its alias-table entry follows the emissive triangles'.
+    pub fn light_select_pdf(&self, k: usize) -> f32 {
+        self.emitters[self.emitters.len() - self.lights.len() + k].select_pdf
+    }
+
+    /// The emitter-buffer rows of the punctual lights (see `gpu_types::punctual_rows`).
+    pub fn punctual_rows(&self) -> Vec<Emitter> {
+        let pdfs: Vec<f32> = (0..self.lights.len()).map(|k| self.light_select_pdf(k)).collect();
+        crate::gpu_types::punctual_rows(&self.lights, &pdfs)
     }
 
     pub fn extent(&self) -> f32 {
         (self.bounds.1 - self.bounds.0).max_element()
     }
+}
+
+/// Identical lines collapsed into one with their count ("line (x3)"), in order of first
+/// appearance.
+pub fn collapse_warnings(warnings: &[String]) -> Vec<String> {
+    let mut order: Vec<(&str, usize)> = Vec::new();
+    for w in warnings {
+        match order.iter_mut().find(|(s, _)| *s == w.as_str()) {
+            Some((_, n)) => *n += 1,
+            None => order.push((w.as_str(), 1)),
+        }
+    }
+    order
+        .into_iter()
+        .map(|(s, n)| if n > 1 { format!("{s} (x{n})") } else { s.to_string() })
+        .collect()
 }

@@ -8,14 +8,52 @@ use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::lights::sample_light;
 use restir_pt::ray_offset::offset_ray_origin;
 use restir_pt::render::{RenderSettings, SceneGpu};
-use restir_pt::scene::{Camera, Scene, SceneParts};
+use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
 use restir_pt::vk::{Buffer, BufferUsage};
 
 use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
 
 const RAYS: usize = 20_000;
 
+/// Random triangles, a sphere and emitters, without punctual lights.
 pub fn random_scene(seed: u64) -> Scene {
+    random_scene_lit(seed, vec![])
+}
+
+/// `random_scene` with three punctual lights (point, spot, directional) beside its emitters.
+fn random_scene_with_punctual_lights(seed: u64) -> Scene {
+    random_scene_lit(
+        seed,
+        vec![
+            PunctualLight {
+                kind: PunctualKind::Point,
+                position: Vec3::new(0.5, 3.0, 1.0),
+                direction: -Vec3::Y,
+                intensity: Vec3::new(20.0, 15.0, 10.0),
+                cos_inner: 1.0,
+                cos_outer: -1.0,
+            },
+            PunctualLight {
+                kind: PunctualKind::Spot,
+                position: Vec3::new(-2.0, 4.0, 0.0),
+                direction: Vec3::new(0.3, -1.0, 0.1).normalize(),
+                intensity: Vec3::splat(40.0),
+                cos_inner: 0.9,
+                cos_outer: 0.5,
+            },
+            PunctualLight {
+                kind: PunctualKind::Directional,
+                position: Vec3::ZERO,
+                direction: Vec3::new(-0.2, -1.0, 0.4).normalize(),
+                intensity: Vec3::splat(0.1),
+                cos_inner: 1.0,
+                cos_outer: -1.0,
+            },
+        ],
+    )
+}
+
+fn random_scene_lit(seed: u64, lights: Vec<PunctualLight>) -> Scene {
     let mut r = TestRng(seed);
     let mut triangles = Vec::new();
     for i in 0..6000 {
@@ -65,6 +103,7 @@ pub fn random_scene(seed: u64) -> Scene {
         material_names: vec!["grey".into(), "light".into()],
         environment: Vec3::new(0.2, 0.3, 0.4),
         cameras: vec![Camera::look_at("test", Vec3::new(0.0, 1.0, 12.0), Vec3::ZERO, Vec3::Y, 0.8)],
+        lights,
         warnings: vec![],
     })
 }
@@ -72,7 +111,8 @@ pub fn random_scene(seed: u64) -> Scene {
 #[test]
 fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
     let ctx = gpu();
-    let scene = random_scene(1);
+    // Punctual lights share the alias table: light sampling's delta branch is compared too.
+    let scene = random_scene_with_punctual_lights(1);
     let settings = RenderSettings {
         width: 64,
         height: 48,
@@ -105,12 +145,14 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         "oracle/scene_oracle.comp",
         &scene_gpu.buffers(&params),
         &[bytemuck::cast_slice(&inputs)],
-        RAYS * 20,
+        RAYS * 24,
         RAYS as u32,
     );
 
     let camera = &scene.cameras[0];
     let mut hits = 0;
+    let mut punctual_samples = 0;
+    let mut punctual_shadowed = 0;
     for i in 0..RAYS {
         let (o, d, u, px) = (
             inputs[4 * i],
@@ -119,7 +161,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
             inputs[4 * i + 3],
         );
         let h = trace_closest(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
-        let g = &out[5 * i..5 * i + 5];
+        let g = &out[6 * i..6 * i + 6];
         assert_eq!(
             g[0].y.to_bits(),
             h.triangle,
@@ -154,7 +196,21 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         let dir = camera.ray_dir(px.x, px.y, settings.width, settings.height);
         assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
         assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
+        if restir_pt::lights::is_punctual_light(ls.triangle) {
+            punctual_samples += 1;
+            let shadowed = restir_pt::lights::punctual_occluded(&scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+            assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
+            punctual_shadowed += shadowed as usize;
+        }
     }
+    assert!(
+        punctual_samples > RAYS / 20,
+        "only {punctual_samples} light samples chose a punctual light: the delta branch is not exercised"
+    );
+    assert!(
+        punctual_shadowed > 0 && punctual_shadowed < punctual_samples,
+        "punctual shadow rays: {punctual_shadowed} of {punctual_samples} blocked; both outcomes must occur"
+    );
     assert!(
         hits > RAYS / 4,
         "only {hits} of {RAYS} rays hit: the scene does not exercise traversal"

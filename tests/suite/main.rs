@@ -14,6 +14,8 @@ mod layout;
 mod ray_offset;
 mod restir;
 mod rng_oracle;
+mod punctual;
+mod real_scenes;
 mod robustness;
 mod sampling_oracle;
 mod sampling_statistics;

@@ -101,6 +101,8 @@ fn robustness_bad_input_corpus_gives_clear_errors_or_warnings() {
                 }
                 let (_, _, pixels) = restir_pt::image_io::read_exr(&out).unwrap();
                 assert!(pixels.iter().all(|p| p.is_finite()), "{file}: non-finite pixels");
+                let mean = pixels.iter().map(|p| p.element_sum()).sum::<f32>() / (3 * pixels.len()) as f32;
+                assert!(mean > 1e-3, "{file}: black image (mean {mean})");
             }
             other => panic!("unknown outcome {other} for {file}"),
         }

@@ -85,9 +85,17 @@ fn loader_drops_degenerate_triangles_and_zero_area_emitters_with_warnings() {
 }
 
 #[test]
-fn loader_rejects_scenes_without_light_or_triangles() {
+fn loader_gives_a_lightless_scene_the_default_environment_and_rejects_one_without_triangles() {
     let path = scene_file("dark.gltf", floor(), None, |_| {});
-    assert!(load_error(&path).contains("no light"));
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.environment, restir_pt::scene::DEFAULT_ENVIRONMENT);
+    assert_eq!(scene.environment, Vec3::ONE);
+    assert_eq!(scene.env_select_prob, 1.0);
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("dark.gltf") && w.contains("no light") && w.contains("radiance 1")),
+        "{:?}",
+        scene.warnings
+    );
     let empty = MeshData {
         positions: vec![Vec3::ZERO; 3],
         indices: vec![0, 1, 2],
@@ -221,4 +229,55 @@ fn loader_recentres_the_scene_on_its_first_camera_in_f64() {
         v
     };
     assert_eq!(sorted(&far_scene), sorted(&near));
+}
+
+#[test]
+fn loader_recentres_a_scene_without_camera_on_its_bounds_centre_in_f64() {
+    // No camera, and a point light at (0.5, 2, 0) beside the floor and the lamp.
+    let camera_less = |v: &mut Value| {
+        v.as_object_mut().unwrap().remove("cameras");
+        for node in v["nodes"].as_array_mut().unwrap() {
+            node.as_object_mut().unwrap().remove("camera");
+        }
+        let used = v.as_object_mut().unwrap().entry("extensionsUsed").or_insert(json!([]));
+        used.as_array_mut().unwrap().push(json!("KHR_lights_punctual"));
+        v["extensions"]["KHR_lights_punctual"] = json!({ "lights": [{ "type": "point", "intensity": 10.0 }] });
+        let nodes = v["nodes"].as_array_mut().unwrap();
+        nodes.push(json!({ "translation": [0.5, 2.0, 0.0], "extensions": { "KHR_lights_punctual": { "light": 0 } } }));
+        let light = nodes.len() - 1;
+        v["scenes"][0]["nodes"].as_array_mut().unwrap().push(json!(light));
+    };
+    let far = 1e5f64;
+    let moved = scene_file("far-no-camera.gltf", floor(), Some(lamp()), |v| {
+        camera_less(v);
+        let roots = v["scenes"][0]["nodes"].clone();
+        let nodes = v["nodes"].as_array_mut().unwrap();
+        nodes.push(json!({ "children": roots, "translation": [far, 0.0, -far] }));
+        v["scenes"][0]["nodes"] = json!([nodes.len() - 1]);
+    });
+    let near = load_scene(&scene_file("near-no-camera.gltf", floor(), Some(lamp()), camera_less)).unwrap();
+    let far_scene = load_scene(&moved).unwrap();
+    // The vertices span (-1, 0, -1) .. (1, 1, 1); the light is not geometry.
+    assert_eq!(near.origin, glam::DVec3::new(0.0, 0.5, 0.0));
+    assert_eq!(far_scene.origin, near.origin + glam::DVec3::new(far, 0.0, -far));
+    assert_eq!(near.bounds, (Vec3::new(-1.0, -0.5, -1.0), Vec3::new(1.0, 0.5, 1.0)));
+    assert_eq!(far_scene.bounds, near.bounds);
+    assert_eq!(far_scene.lights[0].position, Vec3::new(0.5, 1.5, 0.0));
+    assert_eq!(far_scene.lights[0].position, near.lights[0].position);
+    // The default camera frames the re-centred bounds, so it too is the same wherever the scene sits.
+    assert_eq!(far_scene.cameras[0].position, near.cameras[0].position);
+    assert_eq!(far_scene.cameras[0].forward, near.cameras[0].forward);
+    let bits = |s: &restir_pt::scene::Scene| {
+        let mut v: Vec<[u32; 9]> = s
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.vertices().map(|p| p.to_array().map(f32::to_bits));
+                [a, b, c].concat().try_into().unwrap()
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(bits(&far_scene), bits(&near));
 }

@@ -1,0 +1,77 @@
+//! The triangle count a file will produce, estimated from its accessor counts before any vertex
+//! is read, so that a scene past the device's per-binding limit fails at once rather than after
+//! the load and the BVH build.
+
+use anyhow::{bail, Result};
+
+use super::gltf_loader::{problem, Loader, MAX_NODE_DEPTH, MAX_NODE_INSTANCES};
+use crate::gpu_types::Triangle;
+
+/// Triangles a primitive of `mode` draws from `count` vertices or indices (before degenerate
+/// ones are dropped); points and lines draw none.
+fn triangles_of(mode: gltf::mesh::Mode, count: usize) -> usize {
+    use gltf::mesh::Mode;
+    match mode {
+        Mode::Triangles => count / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
+        _ => 0,
+    }
+}
+
+fn mesh_triangles(mesh: &gltf::Mesh) -> usize {
+    mesh.primitives()
+        .map(|p| {
+            let count = match p.indices() {
+                Some(i) => i.count(),
+                None => p.get(&gltf::Semantic::Positions).map_or(0, |a| a.count()),
+            };
+            triangles_of(p.mode(), count)
+        })
+        .sum()
+}
+
+impl Loader<'_> {
+    /// Walks the scene's node instances (as the load will, within the same depth and instance
+    /// limits) and sums the triangles of their meshes, times `EXT_mesh_gpu_instancing` counts.
+    pub(super) fn estimate_triangles(&self, scene: &gltf::Scene) -> usize {
+        let mut total = 0usize;
+        let mut visits = 0usize;
+        let mut stack: Vec<(gltf::Node, usize)> = scene.nodes().map(|n| (n, 0)).collect();
+        while let Some((node, depth)) = stack.pop() {
+            visits += 1;
+            if depth > MAX_NODE_DEPTH || visits > MAX_NODE_INSTANCES {
+                break;
+            }
+            if let Some(mesh) = node.mesh() {
+                let copies = self.instancing.get(&node.index()).map_or(1, |inst| {
+                    [inst.translation, inst.rotation, inst.scale]
+                        .into_iter()
+                        .flatten()
+                        .filter_map(|a| self.doc.accessors().nth(a).map(|a| a.count()))
+                        .min()
+                        .unwrap_or(1)
+                });
+                total = total.saturating_add(mesh_triangles(&mesh).saturating_mul(copies));
+            }
+            stack.extend(node.children().map(|c| (c, depth + 1)));
+        }
+        total
+    }
+
+    /// Fails if the estimated triangles would not fit one storage-buffer binding of
+    /// `limit_bytes` (the device's maxStorageBufferRange).
+    pub(super) fn check_binding_budget(&self, scene: &gltf::Scene, limit_bytes: u64) -> Result<()> {
+        let estimate = self.estimate_triangles(scene);
+        let bytes = estimate as u64 * std::mem::size_of::<Triangle>() as u64;
+        if bytes > limit_bytes {
+            bail!(problem(
+                self.path,
+                format!(
+                    "about {estimate} triangles need {bytes} bytes in one storage buffer, more than the device allows per binding ({limit_bytes} bytes, maxStorageBufferRange; at most {} triangles)",
+                    limit_bytes / std::mem::size_of::<Triangle>() as u64
+                )
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,200 @@
+//! glTF materials to [`Material`]: metallic-roughness factors, emission, transmission, and the
+//! approximations for `KHR_materials_unlit`, `KHR_materials_pbrSpecularGlossiness` and COLOR_0.
+
+use anyhow::{bail, Result};
+use glam::Vec3;
+
+use super::gltf_loader::{problem, Loader};
+use crate::gpu_types::{Material, MATERIAL_DOUBLE_SIDED};
+
+/// Specular reflectance at normal incidence of dielectrics in the metallic-roughness model.
+const DIELECTRIC_F0: f32 = 0.04;
+
+/// Perceived brightness of a colour, as the Khronos spec-gloss conversion example weighs it.
+fn perceived_brightness(c: Vec3) -> f32 {
+    (0.299 * c.x * c.x + 0.587 * c.y * c.y + 0.114 * c.z * c.z).sqrt()
+}
+
+/// The metallic factor whose mix of a dielectric and a conductor best matches the diffuse and
+/// specular brightness: the root of a quadratic in `metallic` (Khronos glTF sample
+/// "convert-between-workflows", `solveMetallic`).
+fn solve_metallic(diffuse: f32, specular: f32, one_minus_specular_strength: f32) -> f32 {
+    if specular < DIELECTRIC_F0 {
+        return 0.0;
+    }
+    let a = DIELECTRIC_F0;
+    let b = diffuse * one_minus_specular_strength / (1.0 - DIELECTRIC_F0) + specular - 2.0 * DIELECTRIC_F0;
+    let c = DIELECTRIC_F0 - specular;
+    let d = (b * b - 4.0 * a * c).max(0.0);
+    ((-b + d.sqrt()) / (2.0 * a)).clamp(0.0, 1.0)
+}
+
+/// Specular-glossiness factors to (base colour, metallic, roughness), approximately: roughness is
+/// 1 - glossiness, metallic solves [`solve_metallic`], and the base colour blends the colour
+/// implied by the diffuse term with the one implied by the specular term by metallic².
+pub fn spec_gloss_to_metal_rough(diffuse: Vec3, specular: Vec3, glossiness: f32) -> (Vec3, f32, f32) {
+    let one_minus = 1.0 - specular.max_element();
+    let metallic = solve_metallic(perceived_brightness(diffuse), perceived_brightness(specular), one_minus);
+    let from_diffuse = diffuse * (one_minus / (1.0 - DIELECTRIC_F0) / (1.0 - metallic).max(1e-4));
+    let from_specular = (specular - Vec3::splat(DIELECTRIC_F0 * (1.0 - metallic))) / metallic.max(1e-4);
+    let base = from_diffuse.lerp(from_specular, metallic * metallic);
+    (base.clamp(Vec3::ZERO, Vec3::ONE), metallic, (1.0 - glossiness).clamp(0.0, 1.0))
+}
+
+impl Loader<'_> {
+    pub(super) fn load_materials(&mut self) -> Result<()> {
+        let doc = self.doc;
+        let mut spec_gloss = 0;
+        for m in doc.materials() {
+            let name = m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
+            spec_gloss += m.pbr_specular_glossiness().is_some() as usize;
+            let material = self.convert_material(&m, &name)?;
+            self.materials.push(material);
+            self.material_names.push(name);
+            self.unlit.push(m.unlit());
+        }
+        let unlit = self.unlit.iter().filter(|&&u| u).count();
+        if unlit > 0 {
+            self.warn(format!(
+                "{unlit} KHR_materials_unlit material(s) rendered as emission of their base colour (no reflection)"
+            ));
+        }
+        if spec_gloss > 0 {
+            self.warn(format!(
+                "{spec_gloss} KHR_materials_pbrSpecularGlossiness material(s) converted to metallic-roughness approximately"
+            ));
+        }
+        Ok(())
+    }
+
+    fn warn_ignored_textures(&mut self, m: &gltf::Material, name: &str) {
+        let pbr = m.pbr_metallic_roughness();
+        let sg = m.pbr_specular_glossiness();
+        let ignored_textures = [
+            ("base colour", pbr.base_color_texture().is_some()),
+            ("metallic-roughness", pbr.metallic_roughness_texture().is_some()),
+            ("normal", m.normal_texture().is_some()),
+            ("occlusion", m.occlusion_texture().is_some()),
+            ("emissive", m.emissive_texture().is_some()),
+            ("transmission", m.transmission().is_some_and(|t| t.transmission_texture().is_some())),
+            ("diffuse", sg.as_ref().is_some_and(|s| s.diffuse_texture().is_some())),
+            (
+                "specular-glossiness",
+                sg.as_ref().is_some_and(|s| s.specular_glossiness_texture().is_some()),
+            ),
+        ];
+        for (kind, present) in ignored_textures {
+            if present {
+                self.warn(format!(
+                    "{name}: {kind} texture ignored (textures are not supported; factors are used)"
+                ));
+            }
+        }
+    }
+
+    fn convert_material(&mut self, m: &gltf::Material, name: &str) -> Result<Material> {
+        self.warn_ignored_textures(m, name);
+        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+            self.warn(format!("{name}: alpha mode {:?} ignored (rendered opaque)", m.alpha_mode()));
+        }
+        if m.volume().is_some() {
+            self.warn(format!("{name}: KHR_materials_volume ignored (no participating media)"));
+        }
+        let pbr = m.pbr_metallic_roughness();
+        let (mut base, mut metallic, mut roughness) = (
+            Vec3::from_slice(&pbr.base_color_factor()[..3]),
+            pbr.metallic_factor(),
+            pbr.roughness_factor(),
+        );
+        if let Some(sg) = m.pbr_specular_glossiness() {
+            let diffuse = Vec3::from_slice(&sg.diffuse_factor()[..3]);
+            (base, metallic, roughness) =
+                spec_gloss_to_metal_rough(diffuse, Vec3::from(sg.specular_factor()), sg.glossiness_factor());
+        }
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let emissive = m.emissive_factor();
+        let transmission = m.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0);
+        let ior = m.ior().unwrap_or(1.5);
+        let checks = [
+            ("baseColorFactor", base.is_finite() && base.min_element() >= 0.0 && base.max_element() <= 1.0),
+            ("metallicFactor", (0.0..=1.0).contains(&metallic)),
+            ("roughnessFactor", (0.0..=1.0).contains(&roughness)),
+            ("emissiveFactor", emissive.iter().all(|v| v.is_finite() && *v >= 0.0)),
+            ("emissiveStrength", strength.is_finite() && strength >= 0.0),
+            ("transmissionFactor", (0.0..=1.0).contains(&transmission)),
+            // Within rounding below 1 is index-matched (docs/materials.md), not an error.
+            ("ior", ior.is_finite() && (ior >= 1.0 || crate::bsdf::index_matched(ior))),
+        ];
+        if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
+            bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));
+        }
+        let flags = if m.double_sided() { MATERIAL_DOUBLE_SIDED } else { 0 };
+        if m.unlit() {
+            // An unlit surface shows its base colour whatever the lighting: emission, no BSDF.
+            return Ok(Material {
+                base_color: [0.0; 3],
+                metallic: 0.0,
+                emission: base.into(),
+                roughness: 1.0,
+                transmission: 0.0,
+                ior: 1.5,
+                flags,
+                pad: 0,
+            });
+        }
+        Ok(Material {
+            base_color: base.into(),
+            metallic,
+            emission: (Vec3::from(emissive) * strength).into(),
+            roughness,
+            transmission,
+            ior,
+            flags,
+            pad: 0,
+        })
+    }
+
+    pub(super) fn default_material(&mut self) -> u32 {
+        *self.default_material.get_or_insert_with(|| {
+            // glTF's default material: white, metallic 1, roughness 1.
+            self.materials.push(Material {
+                base_color: [1.0; 3],
+                metallic: 1.0,
+                roughness: 1.0,
+                ior: 1.5,
+                ..Default::default()
+            });
+            self.material_names.push("glTF default material".to_string());
+            self.unlit.push(false);
+            (self.materials.len() - 1) as u32
+        })
+    }
+
+    /// The material `material` with its base colour (an unlit one: its emission) multiplied by a
+    /// vertex colour; variants are shared between triangles of the same colour.
+    pub(super) fn colour_variant(&mut self, material: u32, colour: Vec3) -> u32 {
+        if colour == Vec3::ONE {
+            return material;
+        }
+        let key = (material, colour.to_array().map(f32::to_bits));
+        if let Some(&v) = self.colour_variants.get(&key) {
+            return v;
+        }
+        let mut m = self.materials[material as usize];
+        if self.unlit[material as usize] {
+            m.emission = (Vec3::from(m.emission) * colour).into();
+        } else {
+            m.base_color = (Vec3::from(m.base_color) * colour).into();
+        }
+        let name = format!("{} × COLOR_0 {:?}", self.material_names[material as usize], colour.to_array());
+        self.materials.push(m);
+        self.material_names.push(name);
+        self.unlit.push(self.unlit[material as usize]);
+        let v = (self.materials.len() - 1) as u32;
+        self.colour_variants.insert(key, v);
+        v
+    }
+}

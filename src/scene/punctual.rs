@@ -1,0 +1,109 @@
+//! `KHR_lights_punctual`: point, spot and directional lights in world space, with the
+//! extension's units (point and spot intensity in candela, directional in lux).
+
+use anyhow::{bail, Result};
+use glam::{DMat4, DVec3, Vec3};
+
+use super::gltf_loader::{problem, Loader};
+use super::luminance;
+
+/// The kind of a punctual light; the values are those of glsl/types.glsl.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PunctualKind {
+    Point = 0,
+    Spot = 1,
+    Directional = 2,
+}
+
+/// A punctual light in scene coordinates (world space translated by `Scene::origin`). Radiometry: the renderer's radiance unit is the glTF
+/// emission unit (1 nit), so a point or spot light of `intensity` I (candela, times `color`)
+/// gives irradiance I·cosθ/d² at distance d, and a directional light of I (lux) gives
+/// irradiance I·cosθ everywhere (KHR_lights_punctual, "Units").
+#[derive(Debug, Clone, PartialEq)]
+pub struct PunctualLight {
+    pub kind: PunctualKind,
+    /// Position (point and spot) relative to `Scene::origin`, unused for directional lights.
+    pub position: Vec3,
+    /// Unit direction the light shines along (spot and directional; the node's -Z).
+    pub direction: Vec3,
+    /// colour × intensity: radiant intensity (point, spot) or irradiance (directional).
+    pub intensity: Vec3,
+    /// Cosines of the spot cone's inner and outer angles (1 and -1 for other kinds).
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+}
+
+impl PunctualLight {
+    /// Emitted power (luminance-weighted) used to choose lights in NEE in proportion to power
+    /// beside emissive triangles: 4πI for a point light, the solid angle of the cone halfway
+    /// between the inner and outer angles times I for a spot, and I times the area of the
+    /// scene's bounding disc (radius `scene_radius`) for a directional light (as pbrt-v4's
+    /// DistantLight::Phi).
+    pub fn power(&self, scene_radius: f32) -> f32 {
+        let i = luminance(self.intensity);
+        match self.kind {
+            PunctualKind::Point => 4.0 * std::f32::consts::PI * i,
+            PunctualKind::Spot => {
+                let cos_mid = 0.5 * (self.cos_inner + self.cos_outer);
+                2.0 * std::f32::consts::PI * (1.0 - cos_mid) * i
+            }
+            PunctualKind::Directional => std::f32::consts::PI * scene_radius * scene_radius * i,
+        }
+    }
+}
+
+impl Loader<'_> {
+    /// Adds the light of `node` with world transform `world`; its position is kept in f64 world
+    /// space (`light_positions`) until the walk has chosen the scene's origin.
+    pub(super) fn add_light(&mut self, light: &gltf::khr_lights_punctual::Light, node: &gltf::Node, world: &DMat4) -> Result<()> {
+        use gltf::khr_lights_punctual::Kind;
+        let colour = Vec3::from(light.color());
+        let intensity = light.intensity();
+        if !colour.is_finite() || colour.min_element() < 0.0 || !intensity.is_finite() || intensity < 0.0 {
+            bail!(problem(
+                self.path,
+                format!("light on node {}: color and intensity must be finite and non-negative", node.index())
+            ));
+        }
+        if light.range().is_some() {
+            self.warn("KHR_lights_punctual range ignored: lights fall off with the inverse square of distance");
+        }
+        let (kind, cos_inner, cos_outer) = match light.kind() {
+            Kind::Point => (PunctualKind::Point, 1.0, -1.0),
+            Kind::Directional => (PunctualKind::Directional, 1.0, -1.0),
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let ok = (0.0..=std::f32::consts::FRAC_PI_2).contains(&outer_cone_angle)
+                    && (0.0..outer_cone_angle.max(f32::MIN_POSITIVE)).contains(&inner_cone_angle);
+                if !ok {
+                    bail!(problem(
+                        self.path,
+                        format!(
+                            "spot light on node {}: cone angles must satisfy 0 <= inner < outer <= pi/2 (inner {inner_cone_angle}, outer {outer_cone_angle})",
+                            node.index()
+                        )
+                    ));
+                }
+                (PunctualKind::Spot, inner_cone_angle.cos(), outer_cone_angle.cos())
+            }
+        };
+        let direction = world.transform_vector3(-DVec3::Z).normalize().as_vec3();
+        if !direction.is_finite() {
+            bail!(problem(self.path, format!("light on node {} has a degenerate transform", node.index())));
+        }
+        if luminance(colour * intensity) > 0.0 {
+            self.light_positions.push(world.transform_point3(DVec3::ZERO));
+            self.lights.push(PunctualLight {
+                kind,
+                position: Vec3::ZERO,
+                direction,
+                intensity: colour * intensity,
+                cos_inner,
+                cos_outer,
+            });
+        }
+        Ok(())
+    }
+}
