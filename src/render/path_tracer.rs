@@ -23,9 +23,11 @@ const MAX_CHUNK_GROWTH: u32 = 8;
 /// pixels whose paths cost more than the ones measured so far.
 const LOOP_BUDGET_SHARE: f64 = 0.25;
 /// Words of glsl/pathtrace.comp's Status block: max loop iterations, subgroups with a cut loop,
-/// paths with a non-finite radiance or throughput, the 64-bit profile counters and the subgroup
-/// size.
-const STATUS_WORDS: u64 = 4 + 2 * COUNTER_COUNT as u64;
+/// paths with a non-finite radiance or throughput, a pad word (the counters are 8-byte aligned),
+/// the 64-bit profile counters and the subgroup size.
+const STATUS_WORDS: u64 = 5 + 2 * COUNTER_COUNT as u64;
+/// The first word of the profile counters in the Status block.
+const COUNTER_WORDS_START: usize = 4;
 const LOCAL_SIZE: u32 = 8;
 
 pub struct RenderStats {
@@ -180,7 +182,7 @@ impl PathTracer {
         }
         self.samples_done += samples;
         if let Some(c) = self.counters.as_mut() {
-            let words = &status[3..];
+            let words = &status[COUNTER_WORDS_START..];
             c.add(&TraversalCounters::from_words(words, words[2 * COUNTER_COUNT]));
         }
         Ok((self.timer.read_ms(1)?.map(|t| t[0]), iterations, nonfinite))
