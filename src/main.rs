@@ -30,6 +30,9 @@ enum Command {
     Bench(BenchCmd),
     /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
     Reference(ReferenceCmd),
+    /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out) and variance
+    /// EXR (<out>.variance.exr) one `reference` process of the same seed and spp writes.
+    Merge(MergeCmd),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
     Profile(ProfileCmd),
     /// Error against GPU time per frame for each method at equal time budgets, against a
@@ -262,8 +265,25 @@ struct ReferenceCmd {
     /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
     #[arg(long)]
     allow_nonfinite: bool,
+    /// Render only share I of N (0-based) of the --spp samples, disjoint from the other shares,
+    /// and write their per-pixel sums to --out as a shard EXR for `merge`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
     #[command(flatten)]
     device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct MergeCmd {
+    /// Shard EXRs written by `reference --shard I/N`.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    #[arg(long)]
+    out: PathBuf,
+    /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
+    #[arg(long)]
+    allow_nonfinite: bool,
 }
 
 #[derive(Args)]
@@ -405,7 +425,7 @@ fn main() -> ExitCode {
             let kernels = i.kernels.then(|| (i.restir.settings(), i.device.into()));
             cli::info(&i.scene, kernels)
         }
-        Command::Reference(r) => cli::reference(cli::ReferenceArgs {
+        Command::Reference(r) => r.shard.as_deref().map(cli::ShardSpec::parse).transpose().and_then(|shard| cli::reference(cli::ReferenceArgs {
             scene: r.scene,
             spp: r.spp,
             width: r.width,
@@ -415,8 +435,10 @@ fn main() -> ExitCode {
             seed: r.seed,
             out: r.out,
             allow_nonfinite: r.allow_nonfinite,
+            shard,
             device: r.device.into(),
-        }),
+        })),
+        Command::Merge(m) => cli::merge(&m.shards, &m.out, m.allow_nonfinite),
         Command::Profile(p) => cli::profile(cli::ProfileArgs {
             restir: p.restir.settings(),
             scene: p.scene,

@@ -7,6 +7,7 @@ mod method_spec;
 mod profile;
 mod reference;
 mod render;
+mod shard;
 mod stability;
 
 pub use bench::{bench, BenchArgs};
@@ -16,6 +17,7 @@ pub use method_spec::MethodSpec;
 pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, Method, RenderArgs};
+pub use shard::{merge, merge_shards, read_shard, ShardMeta, ShardSpec, ShardSums};
 pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
 
 use std::path::{Path, PathBuf};

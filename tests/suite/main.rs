@@ -21,3 +21,4 @@ mod scene_loader;
 mod scenes;
 mod shift;
 mod speed_accuracy;
+mod sweeps;
