@@ -345,6 +345,8 @@ struct CompareCmd {
     #[arg(long, default_value = "out/compare")]
     out_dir: PathBuf,
     #[command(flatten)]
+    sweep: SweepOpts,
+    #[command(flatten)]
     device: DeviceOpts,
 }
 
@@ -377,7 +379,36 @@ struct StabilityCmd {
     #[arg(long, default_value = "out/stability")]
     out_dir: PathBuf,
     #[command(flatten)]
+    sweep: SweepOpts,
+    #[command(flatten)]
     device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct SweepOpts {
+    /// Write the runs as a job list (JSON lines: each job's command and working folder) to
+    /// this file and run nothing; see tools/cluster/.
+    #[arg(long, value_name = "JOBS.jsonl")]
+    plan: Option<PathBuf>,
+    /// Run only job K (0-based) of the job list these arguments make; it writes
+    /// <out-dir>/jobs/job_K.csv/.json.
+    #[arg(long, value_name = "K")]
+    job: Option<usize>,
+    /// Merge the jobs' files in DIR (normally <out-dir>/jobs) into the usual outputs and
+    /// accounting.csv.
+    #[arg(long, value_name = "DIR")]
+    merge: Option<PathBuf>,
+}
+
+impl SweepOpts {
+    fn mode(self) -> anyhow::Result<cli::SweepMode> {
+        cli::SweepMode::from_flags(self.plan, self.job, self.merge)
+    }
+}
+
+/// The command line after the program name, for job lists.
+fn argv() -> Vec<String> {
+    std::env::args_os().skip(1).map(|a| a.to_string_lossy().into_owned()).collect()
 }
 
 impl From<DeviceOpts> for DeviceArgs {
@@ -425,19 +456,21 @@ fn main() -> ExitCode {
             let kernels = i.kernels.then(|| (i.restir.settings(), i.device.into()));
             cli::info(&i.scene, kernels)
         }
-        Command::Reference(r) => r.shard.as_deref().map(cli::ShardSpec::parse).transpose().and_then(|shard| cli::reference(cli::ReferenceArgs {
-            scene: r.scene,
-            spp: r.spp,
-            width: r.width,
-            height: r.height,
-            max_depth: r.max_depth,
-            camera: r.camera,
-            seed: r.seed,
-            out: r.out,
-            allow_nonfinite: r.allow_nonfinite,
-            shard,
-            device: r.device.into(),
-        })),
+        Command::Reference(r) => r.shard.as_deref().map(cli::ShardSpec::parse).transpose().and_then(|shard| {
+            cli::reference(cli::ReferenceArgs {
+                scene: r.scene,
+                spp: r.spp,
+                width: r.width,
+                height: r.height,
+                max_depth: r.max_depth,
+                camera: r.camera,
+                seed: r.seed,
+                out: r.out,
+                allow_nonfinite: r.allow_nonfinite,
+                shard,
+                device: r.device.into(),
+            })
+        }),
         Command::Merge(m) => cli::merge(&m.shards, &m.out, m.allow_nonfinite),
         Command::Profile(p) => cli::profile(cli::ProfileArgs {
             restir: p.restir.settings(),
@@ -450,37 +483,51 @@ fn main() -> ExitCode {
             out_dir: p.out_dir,
             device: p.device.into(),
         }),
-        Command::Compare(c) => cli::compare(cli::CompareArgs {
-            restir: c.restir.settings(),
-            scene: c.scene,
-            reference: c.reference,
-            methods: c.methods,
-            budgets_ms: c.budgets_ms,
-            frames: c.frames,
-            camera_path: c.camera_path,
-            trials: c.trials,
-            max_depth: c.max_depth,
-            camera: c.camera,
-            seed: c.seed,
-            out_dir: c.out_dir,
-            device: c.device.into(),
-        })
-        .map(|_| ()),
-        Command::Stability(s) => cli::stability(cli::StabilityArgs {
-            restir: s.restir.settings(),
-            scenes: s.scenes,
-            methods: s.methods,
-            frames: s.frames,
-            width: s.width,
-            height: s.height,
-            max_depth: s.max_depth,
-            reference_spp: s.reference_spp,
-            pt_spp: s.pt_spp,
-            seed: s.seed,
-            out_dir: Some(s.out_dir),
-            device: s.device.into(),
-        })
-        .map(|_| ()),
+        Command::Compare(c) => c
+            .sweep
+            .mode()
+            .and_then(|sweep| {
+                cli::compare(cli::CompareArgs {
+                    restir: c.restir.settings(),
+                    scene: c.scene,
+                    reference: c.reference,
+                    methods: c.methods,
+                    budgets_ms: c.budgets_ms,
+                    frames: c.frames,
+                    camera_path: c.camera_path,
+                    trials: c.trials,
+                    max_depth: c.max_depth,
+                    camera: c.camera,
+                    seed: c.seed,
+                    out_dir: c.out_dir,
+                    sweep,
+                    argv: argv(),
+                    device: c.device.into(),
+                })
+            })
+            .map(|_| ()),
+        Command::Stability(s) => s
+            .sweep
+            .mode()
+            .and_then(|sweep| {
+                cli::stability(cli::StabilityArgs {
+                    restir: s.restir.settings(),
+                    scenes: s.scenes,
+                    methods: s.methods,
+                    frames: s.frames,
+                    width: s.width,
+                    height: s.height,
+                    max_depth: s.max_depth,
+                    reference_spp: s.reference_spp,
+                    pt_spp: s.pt_spp,
+                    seed: s.seed,
+                    out_dir: Some(s.out_dir),
+                    sweep,
+                    argv: argv(),
+                    device: s.device.into(),
+                })
+            })
+            .map(|_| ()),
         Command::Bench(b) => cli::bench(cli::BenchArgs {
             scene: b.scene,
             width: b.width,

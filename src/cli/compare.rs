@@ -2,6 +2,7 @@
 //! against a path-traced reference. Writes results.csv, error-against-time charts (SVG and PNG)
 //! and an equal-time image strip with insets.
 
+use std::cell::Cell;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -9,6 +10,7 @@ use anyhow::{bail, Context as _, Result};
 use glam::Vec3;
 
 use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
+use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
 use crate::image_io::read_exr;
@@ -34,6 +36,10 @@ pub struct CompareArgs {
     pub seed: u32,
     pub restir: RestirSettings,
     pub out_dir: PathBuf,
+    /// One process for everything, or a job list, one job of it, or the merge of its jobs.
+    pub sweep: SweepMode,
+    /// The command line after `restir-pt` (for the job list's commands).
+    pub argv: Vec<String>,
     pub device: DeviceArgs,
 }
 
@@ -54,7 +60,7 @@ pub struct CompareRow {
 }
 
 /// A method's frame cost, measured after its kernels are compiled.
-enum Cost {
+pub(super) enum Cost {
     /// Path tracing: GPU ms per frame of its own and per sample per pixel. A frame's fixed cost
     /// (about 7 ms, cornell-glossy at 64x64 on llvmpipe) is not small beside a sample (about
     /// 6 ms): a cost of 8 spp over 8 gave 2 spp a 21 ms budget and they took 30 ms.
@@ -80,10 +86,12 @@ impl Cost {
 /// three frames once filled half a budget.
 const CALIBRATION_FRAMES: u32 = 8;
 
-struct Run<'a> {
-    scene: &'a Scene,
-    settings: &'a RenderSettings,
-    camera_path: bool,
+pub(super) struct Run<'a> {
+    pub scene: &'a Scene,
+    pub settings: &'a RenderSettings,
+    pub camera_path: bool,
+    /// GPU ms of every frame rendered so far (calibration included), for the job's accounting.
+    pub gpu_ms: Cell<f64>,
 }
 
 /// What `Run::sequence` measured.
@@ -95,7 +103,7 @@ struct Sequence {
 
 impl Run<'_> {
     /// The camera of frame `frame`.
-    fn camera(&self, frame: u32) -> usize {
+    pub(super) fn camera(&self, frame: u32) -> usize {
         if self.camera_path {
             camera_on_path(self.settings.camera, frame, self.scene.cameras.len())
         } else {
@@ -114,6 +122,7 @@ impl Run<'_> {
         let (mut times, mut failed, mut last) = (vec![], vec![], None);
         for f in 0..frames {
             let (outcome, image) = renderer.frame(self.scene, &settings, self.camera(f), f)?;
+            self.gpu_ms.set(self.gpu_ms.get() + outcome.gpu_ms);
             if f > 0 || frames == 1 {
                 times.push(outcome.gpu_ms);
             }
@@ -130,7 +139,7 @@ impl Run<'_> {
     /// Measures a method's frame cost: the path tracer's per sample, ReSTIR PT's with one
     /// reservoir. The first run compiles the kernels (llvmpipe compiles at the first dispatch)
     /// and is not counted.
-    fn calibrate(&self, renderer: &mut MethodRenderer) -> Result<Cost> {
+    pub(super) fn calibrate(&self, renderer: &mut MethodRenderer) -> Result<Cost> {
         match renderer {
             MethodRenderer::PathTracing(..) => {
                 renderer.set_cost_knob(1)?;
@@ -184,7 +193,7 @@ impl Run<'_> {
 
     /// Measures ReSTIR PT frames with more reservoirs until one costs over `max_budget_ms` or
     /// the most reservoirs are measured.
-    fn extend(&self, renderer: &mut MethodRenderer, cost: &mut Cost, max_budget_ms: f64) -> Result<()> {
+    pub(super) fn extend(&self, renderer: &mut MethodRenderer, cost: &mut Cost, max_budget_ms: f64) -> Result<()> {
         if let Cost::PerReservoirs(ms) = cost {
             while ms.last().is_some_and(|&t| t <= max_budget_ms) && ms.len() < MAX_RESERVOIRS as usize {
                 renderer.set_cost_knob(ms.len() as u32 + 1)?;
@@ -220,7 +229,7 @@ fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> 
     best.1
 }
 
-fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
+pub(super) fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
     let mut csv = String::from(
         "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels\n",
     );
@@ -243,8 +252,29 @@ fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
     std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))
 }
 
-/// Runs every method at every budget; returns the rows and writes the CSV, charts and strip.
-pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
+/// What every mode of `compare` reads and checks before it opens a device.
+pub(super) struct Setup {
+    pub path: PathBuf,
+    pub scene: Scene,
+    pub width: u32,
+    pub height: u32,
+    pub reference: Vec<Vec3>,
+    pub methods: Vec<MethodSpec>,
+    pub settings: RenderSettings,
+}
+
+impl Setup {
+    pub(super) fn run(&self, camera_path: bool) -> Run<'_> {
+        Run {
+            scene: &self.scene,
+            settings: &self.settings,
+            camera_path,
+            gpu_ms: Cell::new(0.0),
+        }
+    }
+}
+
+fn setup(args: &CompareArgs) -> Result<Setup> {
     if args.frames == 0 || args.trials == 0 {
         bail!("--frames and --trials must be at least 1");
     }
@@ -279,12 +309,30 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
         }
     }
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
-    let ctx = open_device(&args.device)?;
-    let run = Run {
-        scene: &scene,
-        settings: &settings,
-        camera_path: args.camera_path,
-    };
+    Ok(Setup {
+        path,
+        scene,
+        width,
+        height,
+        reference,
+        methods,
+        settings,
+    })
+}
+
+/// Runs every method at every budget; returns the rows and writes the CSV, charts and strip.
+/// With `args.sweep` other than `All`, writes the job list, runs one job, or merges the jobs'
+/// results instead (compare_sweep.rs).
+pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
+    let setup = setup(&args)?;
+    match &args.sweep {
+        SweepMode::All => compare_all(&args, &setup),
+        mode => super::compare_sweep::compare_sweep(&args, &setup, mode),
+    }
+}
+
+/// Prints which camera the last frame sees when the camera moves.
+pub(super) fn note_camera_path(args: &CompareArgs, run: &Run) {
     if args.camera_path {
         eprintln!(
             "camera path: frame {} sees camera {}; {} must be a reference of that camera",
@@ -293,9 +341,15 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
             args.reference.display()
         );
     }
+}
+
+fn compare_all(args: &CompareArgs, setup: &Setup) -> Result<Vec<CompareRow>> {
+    let ctx = open_device(&args.device)?;
+    let run = setup.run(args.camera_path);
+    note_camera_path(args, &run);
     let mut renderers = vec![];
-    for m in &methods {
-        let mut renderer = MethodRenderer::new(&ctx, &scene, &settings, m)?;
+    for m in &setup.methods {
+        let mut renderer = MethodRenderer::new(&ctx, &setup.scene, &setup.settings, m)?;
         let cost = run.calibrate(&mut renderer)?;
         renderers.push((m.label(), renderer, cost));
     }
@@ -326,74 +380,110 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     let mut images: Vec<(String, f64, Image)> = vec![];
     for (label, renderer, cost) in &mut renderers {
         for &budget in &budgets {
-            let Some(knob) = cost.fit(budget) else {
-                eprintln!("{label}: skipped at {budget:.1} ms, its cheapest frame does not fit");
-                continue;
-            };
-            let knob = run.fit_to_budget(renderer, knob, budget, args.frames)?;
-            let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
-            let mut last = None;
-            for t in 0..args.trials {
-                let seq = run.sequence(renderer, args.frames, args.seed.wrapping_add(1 + t))?;
-                times.push(seq.gpu_ms_per_frame);
-                rel += rel_mse(&seq.last_frame.mean, &reference) / args.trials as f64;
-                trimmed += rel_mse_trimmed(&seq.last_frame.mean, &reference, TRIMMED_SHARE) / args.trials as f64;
-                abs += mse(&seq.last_frame.mean, &reference) / args.trials as f64;
-                energy += energy_ratio(&seq.last_frame.mean, &reference) / args.trials as f64;
-                failed = seq.failed_shift_rate.map(|f| failed.unwrap_or(0.0) + f / args.trials as f64);
-                nonfinite += seq.last_frame.non_finite_count();
-                last = Some(seq.last_frame);
+            if let Some((row, image)) = measure(&run, renderer, cost, label, budget, &setup.reference, args)? {
+                images.push((label.clone(), budget, image));
+                rows.push(row);
             }
-            let row = CompareRow {
-                method: label.clone(),
-                budget_ms: budget,
-                knob: format!("{}={knob}", renderer.cost_knob_name()),
-                gpu_ms_per_frame: median(&times),
-                rel_mse: rel,
-                rel_mse_trimmed: trimmed,
-                mse: abs,
-                energy_ratio: energy,
-                failed_shift_rate: failed,
-                nonfinite_pixels: nonfinite,
-            };
-            println!(
-                "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e} (trimmed {:.4e}) | MSE {:.4e} | energy {:.4}{}",
-                row.method,
-                budget,
-                row.knob,
-                row.gpu_ms_per_frame,
-                row.rel_mse,
-                row.rel_mse_trimmed,
-                row.mse,
-                row.energy_ratio,
-                row.failed_shift_rate
-                    .map(|f| format!(" | failed shifts {:.2}%", 100.0 * f))
-                    .unwrap_or_default()
-            );
-            if row.nonfinite_pixels > 0 {
-                eprintln!(
-                    "warning: {} at {budget} ms: {} non-finite pixels in its last frames (results.csv)",
-                    row.method, row.nonfinite_pixels
-                );
-            }
-            images.push((label.clone(), budget, last.expect("at least one trial")));
-            rows.push(row);
         }
     }
     drop(renderers);
     finish_device(&ctx)?;
-    for line in equal_time_lines(&rows, &budgets) {
+    write_outputs(args, setup, &budgets, &rows, &images, &ctx.info.name)?;
+    Ok(rows)
+}
+
+/// One method at one budget: fits its knob, runs the trials and prints the row. None if even
+/// the method's cheapest frame does not fit. The image is the last trial's last frame.
+pub(super) fn measure(
+    run: &Run,
+    renderer: &mut MethodRenderer,
+    cost: &Cost,
+    label: &str,
+    budget: f64,
+    reference: &[Vec3],
+    args: &CompareArgs,
+) -> Result<Option<(CompareRow, Image)>> {
+    let Some(knob) = cost.fit(budget) else {
+        eprintln!("{label}: skipped at {budget:.1} ms, its cheapest frame does not fit");
+        return Ok(None);
+    };
+    let knob = run.fit_to_budget(renderer, knob, budget, args.frames)?;
+    let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
+    let mut last = None;
+    for t in 0..args.trials {
+        let seq = run.sequence(renderer, args.frames, args.seed.wrapping_add(1 + t))?;
+        times.push(seq.gpu_ms_per_frame);
+        rel += rel_mse(&seq.last_frame.mean, reference) / args.trials as f64;
+        trimmed += rel_mse_trimmed(&seq.last_frame.mean, reference, TRIMMED_SHARE) / args.trials as f64;
+        abs += mse(&seq.last_frame.mean, reference) / args.trials as f64;
+        energy += energy_ratio(&seq.last_frame.mean, reference) / args.trials as f64;
+        failed = seq.failed_shift_rate.map(|f| failed.unwrap_or(0.0) + f / args.trials as f64);
+        nonfinite += seq.last_frame.non_finite_count();
+        last = Some(seq.last_frame);
+    }
+    let row = CompareRow {
+        method: label.to_string(),
+        budget_ms: budget,
+        knob: format!("{}={knob}", renderer.cost_knob_name()),
+        gpu_ms_per_frame: median(&times),
+        rel_mse: rel,
+        rel_mse_trimmed: trimmed,
+        mse: abs,
+        energy_ratio: energy,
+        failed_shift_rate: failed,
+        nonfinite_pixels: nonfinite,
+    };
+    println!(
+        "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e} (trimmed {:.4e}) | MSE {:.4e} | energy {:.4}{}",
+        row.method,
+        budget,
+        row.knob,
+        row.gpu_ms_per_frame,
+        row.rel_mse,
+        row.rel_mse_trimmed,
+        row.mse,
+        row.energy_ratio,
+        row.failed_shift_rate
+            .map(|f| format!(" | failed shifts {:.2}%", 100.0 * f))
+            .unwrap_or_default()
+    );
+    if row.nonfinite_pixels > 0 {
+        eprintln!(
+            "warning: {} at {budget} ms: {} non-finite pixels in its last frames (results.csv)",
+            row.method, row.nonfinite_pixels
+        );
+    }
+    Ok(Some((row, last.expect("at least one trial"))))
+}
+
+/// The equal-time lines, results.csv, the charts and the strip of a whole sweep; `device`
+/// names the device(s) in the charts' titles.
+pub(super) fn write_outputs(
+    args: &CompareArgs,
+    setup: &Setup,
+    budgets: &[f64],
+    rows: &[CompareRow],
+    images: &[(String, f64, Image)],
+    device: &str,
+) -> Result<()> {
+    for line in equal_time_lines(rows, budgets) {
         println!("{line}");
     }
-
-    write_csv(&args.out_dir.join("results.csv"), &rows)?;
+    write_csv(&args.out_dir.join("results.csv"), rows)?;
     let motion = if args.camera_path { "a moving camera" } else { "a static camera" };
-    let title = format!("{} {}x{}, frame {} of {motion}, {}", path.display(), width, height, args.frames, ctx.info.name);
+    let title = format!(
+        "{} {}x{}, frame {} of {motion}, {device}",
+        setup.path.display(),
+        setup.width,
+        setup.height,
+        args.frames
+    );
     for (metric, name, value) in [
         ("rel_mse", "relMSE", (|r: &CompareRow| r.rel_mse) as fn(&CompareRow) -> f64),
         ("mse", "MSE", |r| r.mse),
     ] {
-        let series: Vec<Series> = methods
+        let series: Vec<Series> = setup
+            .methods
             .iter()
             .map(|m| Series {
                 name: m.label(),
@@ -417,18 +507,18 @@ pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
     }
     write_strip(
         &args.out_dir.join("equal_time.png"),
-        &budgets,
-        &methods,
-        &images,
-        &reference,
-        width,
-        height,
+        budgets,
+        &setup.methods,
+        images,
+        &setup.reference,
+        setup.width,
+        setup.height,
     )?;
     eprintln!(
         "wrote results.csv, rel_mse_vs_time.svg/png, mse_vs_time.svg/png and equal_time.png in {}",
         args.out_dir.display()
     );
-    Ok(rows)
+    Ok(())
 }
 
 /// A run whose frames took longer than this multiple of its budget is not an equal-time point:

@@ -2,6 +2,7 @@
 
 mod bench;
 mod compare;
+mod compare_sweep;
 mod info;
 mod method_spec;
 mod profile;
@@ -9,6 +10,7 @@ mod reference;
 mod render;
 mod shard;
 mod stability;
+mod sweep;
 
 pub use bench::{bench, BenchArgs};
 pub use compare::{compare, equal_time_lines, CompareArgs, CompareRow};
@@ -18,6 +20,7 @@ pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, Method, RenderArgs};
 pub use shard::{merge, merge_shards, read_shard, ShardMeta, ShardSpec, ShardSums};
+pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
 pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
 
 use std::path::{Path, PathBuf};

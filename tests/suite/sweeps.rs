@@ -173,3 +173,194 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
     );
     assert!(!dir.join("x.exr").exists());
 }
+
+/// Runs every job of the plan at `plan` as the cluster scripts do (each line's argv from its
+/// cwd), then its merge command; returns the merge's stdout.
+fn run_plan(plan: &Path, jobs: usize) -> String {
+    let text = std::fs::read_to_string(plan).unwrap();
+    let lines: Vec<restir_pt::cli::JobLine> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), jobs, "{text}");
+    for (k, line) in lines.iter().enumerate() {
+        assert_eq!((line.job, line.jobs), (k, jobs));
+        assert_eq!(line.argv[line.argv.len() - 2..], ["--job".to_string(), k.to_string()]);
+        assert!(!line.argv.iter().any(|a| a.starts_with("--plan")), "{:?}", line.argv);
+        let args: Vec<&str> = line.argv.iter().map(String::as_str).collect();
+        let (code, _, stderr) = restir_pt(&args);
+        assert_eq!(code, 0, "job {k}: {stderr}");
+        assert!(stderr.contains(&format!("job {k} of {jobs}")), "{stderr}");
+    }
+    let merge: Vec<&str> = lines[0].merge_argv.iter().map(String::as_str).collect();
+    ok(&merge).0
+}
+
+fn csv_rows(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+/// Each job's report: the device, positive wall, GPU and compile ms, and the build's commit.
+fn check_job_reports(jobs_dir: &Path, jobs: usize) {
+    let head = Command::new("git")
+        .args(["rev-parse", "--short", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    for k in 0..jobs {
+        let path = jobs_dir.join(format!("job_{k:04}.json"));
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert!(!report["device"].as_str().unwrap().is_empty(), "{report}");
+        for field in ["wall_ms", "gpu_ms", "compile_ms"] {
+            assert!(report[field].as_f64().unwrap() > 0.0, "{field}: {report}");
+        }
+        assert!(
+            report["wall_ms"].as_f64().unwrap() >= report["compile_ms"].as_f64().unwrap(),
+            "{report}"
+        );
+        let commit = report["commit"].as_str().unwrap();
+        assert_eq!(commit, head.as_deref().unwrap_or("unknown"), "{report}");
+    }
+}
+
+/// `compare` on cornell at 4x4 as 4 jobs (pt and ReSTIR PT at 0.001 ms and 1e6 ms, where the knobs do not depend
+/// on timing: 1 spp, 65536 spp, skipped, 16 reservoirs) run one by one and merged, against one
+/// process: every column but the GPU time equal.
+#[test]
+fn sweeps_compare_jobs_merge_into_the_one_process_results() {
+    let dir = fresh_dir("compare-sweep");
+    let reference = dir.join("ref.exr");
+    ok(&[
+        "reference",
+        "scenes/cornell.gltf",
+        "--spp",
+        "16",
+        "--width",
+        "4",
+        "--height",
+        "4",
+        "--max-depth",
+        "3",
+        "--out",
+        s(&reference),
+    ]);
+    let (one, split) = (dir.join("one"), dir.join("split"));
+    let args = |out: &Path| {
+        vec![
+            "compare".to_string(),
+            "scenes/cornell.gltf".into(),
+            "--reference".into(),
+            s(&reference).into(),
+            "--methods".into(),
+            "pt,restir:hybrid".into(),
+            "--budgets-ms".into(),
+            "0.001,1000000".into(),
+            "--frames".into(),
+            "2".into(),
+            "--trials".into(),
+            "2".into(),
+            "--max-depth".into(),
+            "3".into(),
+            "--out-dir".into(),
+            s(out).into(),
+        ]
+    };
+    let one_args = args(&one);
+    ok(&one_args.iter().map(String::as_str).collect::<Vec<_>>());
+    let plan = split.join("jobs.jsonl");
+    let mut plan_args = args(&split);
+    plan_args.extend(["--plan".into(), s(&plan).into()]);
+    let (stdout, _) = ok(&plan_args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(stdout.contains("wrote 4 jobs"), "{stdout}");
+    assert!(!split.join("results.csv").exists(), "--plan runs nothing");
+    let merged = run_plan(&plan, 4);
+    assert!(merged.contains("4 jobs: wall"), "{merged}");
+
+    let (a, b) = (csv_rows(&one.join("results.csv")), csv_rows(&split.join("results.csv")));
+    assert_eq!(a.len(), 1 + 3, "pt twice, ReSTIR PT once (skipped at 0.001 ms): {a:?}");
+    assert_eq!(a.len(), b.len());
+    let knobs: Vec<&str> = a[1..].iter().map(|r| r[2].as_str()).collect();
+    assert_eq!(knobs, ["spp=1", "spp=65536", "reservoirs=16"]);
+    for (ra, rb) in a.iter().zip(&b) {
+        for (c, (x, y)) in ra.iter().zip(rb).enumerate() {
+            if a[0][c] != "gpu_ms_per_frame" {
+                assert_eq!(x, y, "column {}: {ra:?} vs {rb:?}", a[0][c]);
+            }
+        }
+    }
+    for file in [
+        "rel_mse_vs_time.svg",
+        "rel_mse_vs_time.png",
+        "mse_vs_time.svg",
+        "mse_vs_time.png",
+        "equal_time.png",
+    ] {
+        assert!(std::fs::metadata(split.join(file)).unwrap().len() > 100, "{file}");
+    }
+    let accounting = csv_rows(&split.join("accounting.csv"));
+    assert_eq!(accounting.len(), 1 + 4, "{accounting:?}");
+    check_job_reports(&split.join("jobs"), 4);
+
+    // A missing job, a job out of range, flags together, a plan without budgets.
+    std::fs::remove_file(split.join("jobs/job_0002.csv")).unwrap();
+    let mut merge_args = args(&split);
+    merge_args.extend(["--merge".into(), s(&split.join("jobs")).into()]);
+    fails(
+        &merge_args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["job_0002.csv", "job 2"],
+    );
+    let mut bad = args(&split);
+    bad.extend(["--job".into(), "4".into()]);
+    fails(&bad.iter().map(String::as_str).collect::<Vec<_>>(), &["--job 4", "4 jobs"]);
+    bad.extend(["--plan".into(), "x.jsonl".into()]);
+    fails(&bad.iter().map(String::as_str).collect::<Vec<_>>(), &["exclude each other"]);
+    let mut no_budgets = args(&split);
+    no_budgets.drain(6..8);
+    no_budgets.extend(["--plan".into(), "x.jsonl".into()]);
+    fails(&no_budgets.iter().map(String::as_str).collect::<Vec<_>>(), &["need --budgets-ms"]);
+}
+
+/// `stability` on cornell, 8x8, 2 frames, as 2 jobs (one per method) merged: the same
+/// stability.csv as one process (no column depends on timing), the chart, and each job's report.
+#[test]
+fn sweeps_stability_jobs_merge_into_the_one_process_results() {
+    let dir = fresh_dir("stability-sweep");
+    let (one, split) = (dir.join("one"), dir.join("split"));
+    let args = |out: &Path| {
+        vec![
+            "stability".to_string(),
+            "--scenes".into(),
+            "scenes/cornell.gltf".into(),
+            "--methods".into(),
+            "pt,restir:hybrid".into(),
+            "--frames".into(),
+            "3".into(),
+            "--width".into(),
+            "8".into(),
+            "--height".into(),
+            "8".into(),
+            "--reference-spp".into(),
+            "8".into(),
+            "--out-dir".into(),
+            s(out).into(),
+        ]
+    };
+    ok(&args(&one).iter().map(String::as_str).collect::<Vec<_>>());
+    let plan = split.join("jobs.jsonl");
+    let mut plan_args = args(&split);
+    plan_args.extend(["--plan".into(), s(&plan).into()]);
+    ok(&plan_args.iter().map(String::as_str).collect::<Vec<_>>());
+    let merged = run_plan(&plan, 2);
+    assert!(merged.contains("cornell") && merged.contains("relMSE last"), "summary: {merged}");
+    let (a, b) = (
+        std::fs::read_to_string(one.join("stability.csv")).unwrap(),
+        std::fs::read_to_string(split.join("stability.csv")).unwrap(),
+    );
+    assert_eq!(a.lines().count(), 1 + 2 * 2 * 3, "{a}");
+    assert_eq!(a, b);
+    assert!(std::fs::metadata(split.join("cornell_rel_mse.png")).unwrap().len() > 100);
+    check_job_reports(&split.join("jobs"), 2);
+}
