@@ -323,44 +323,156 @@ fn sweeps_compare_jobs_merge_into_the_one_process_results() {
     fails(&no_budgets.iter().map(String::as_str).collect::<Vec<_>>(), &["need --budgets-ms"]);
 }
 
-/// `stability` on cornell, 8x8, 2 frames, as 2 jobs (one per method) merged: the same
-/// stability.csv as one process (no column depends on timing), the chart, and each job's report.
+/// `stability` on cornell at 8x8, 3 frames, pt and ReSTIR PT, into `out`.
+fn stability_args(out: &Path) -> Vec<String> {
+    [
+        "stability",
+        "--scenes",
+        "scenes/cornell.gltf",
+        "--methods",
+        "pt,restir:hybrid",
+        "--frames",
+        "3",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--reference-spp",
+        "8",
+        "--out-dir",
+        s(out),
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+fn run(args: &[String]) -> (String, String) {
+    ok(&args.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
+/// Writes the stability plan (2 jobs, one per method) for `out` and returns its path.
+fn stability_plan(out: &Path) -> PathBuf {
+    let plan = out.join("jobs.jsonl");
+    let mut args = stability_args(out);
+    args.extend(["--plan".into(), s(&plan).into()]);
+    run(&args);
+    plan
+}
+
+/// The one-process stability.csv (made once per test binary run).
+fn stability_one_process() -> String {
+    static ONE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    ONE.get_or_init(|| {
+        let out = fresh_dir("stability-one");
+        run(&stability_args(&out));
+        std::fs::read_to_string(out.join("stability.csv")).unwrap()
+    })
+    .clone()
+}
+
+/// `stability` as 2 jobs merged: the same stability.csv as one process (no column depends on
+/// timing), the summary, the chart, and each job's report.
 #[test]
 fn sweeps_stability_jobs_merge_into_the_one_process_results() {
-    let dir = fresh_dir("stability-sweep");
-    let (one, split) = (dir.join("one"), dir.join("split"));
-    let args = |out: &Path| {
-        vec![
-            "stability".to_string(),
-            "--scenes".into(),
-            "scenes/cornell.gltf".into(),
-            "--methods".into(),
-            "pt,restir:hybrid".into(),
-            "--frames".into(),
-            "3".into(),
-            "--width".into(),
-            "8".into(),
-            "--height".into(),
-            "8".into(),
-            "--reference-spp".into(),
-            "8".into(),
-            "--out-dir".into(),
-            s(out).into(),
-        ]
-    };
-    ok(&args(&one).iter().map(String::as_str).collect::<Vec<_>>());
-    let plan = split.join("jobs.jsonl");
-    let mut plan_args = args(&split);
-    plan_args.extend(["--plan".into(), s(&plan).into()]);
-    ok(&plan_args.iter().map(String::as_str).collect::<Vec<_>>());
-    let merged = run_plan(&plan, 2);
+    let split = fresh_dir("stability-split");
+    let merged = run_plan(&stability_plan(&split), 2);
     assert!(merged.contains("cornell") && merged.contains("relMSE last"), "summary: {merged}");
-    let (a, b) = (
-        std::fs::read_to_string(one.join("stability.csv")).unwrap(),
-        std::fs::read_to_string(split.join("stability.csv")).unwrap(),
-    );
-    assert_eq!(a.lines().count(), 1 + 2 * 2 * 3, "{a}");
-    assert_eq!(a, b);
+    let one = stability_one_process();
+    assert_eq!(one.lines().count(), 1 + 2 * 2 * 3, "{one}");
+    assert_eq!(one, std::fs::read_to_string(split.join("stability.csv")).unwrap());
     assert!(std::fs::metadata(split.join("cornell_rel_mse.png")).unwrap().len() > 100);
     check_job_reports(&split.join("jobs"), 2);
+}
+
+fn script(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/cluster").join(name)
+}
+
+/// tools/cluster/slurm.sh: valid bash; `submit` asks sbatch (a stand-in here that logs its
+/// arguments) for an array of one task per job and a merge after the whole array; the array
+/// tasks (SLURM_ARRAY_TASK_ID set as Slurm sets it) and the merge make stability.csv equal
+/// to one process's.
+#[test]
+fn sweeps_slurm_script_submits_runs_and_merges_a_plan() {
+    let slurm = script("slurm.sh");
+    let syntax = Command::new("bash").arg("-n").arg(&slurm).output().unwrap();
+    assert!(syntax.status.success(), "bash -n: {}", String::from_utf8_lossy(&syntax.stderr));
+
+    let out = fresh_dir("stability-slurm");
+    let plan = stability_plan(&out);
+    let bin = out.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let log = out.join("sbatch.log");
+    std::fs::write(bin.join("sbatch"), format!("#!/bin/sh\necho \"$*\" >> {}\necho 4242\n", s(&log))).unwrap();
+    Command::new("chmod").arg("+x").arg(bin.join("sbatch")).status().unwrap();
+    let path = format!("{}:{}", s(&bin), std::env::var("PATH").unwrap_or_default());
+    let slurm_run = |args: &[&str], task: Option<usize>| {
+        let mut cmd = Command::new("bash");
+        cmd.arg(&slurm)
+            .args(args)
+            .env("PATH", &path)
+            .env("RESTIR_PT", env!("CARGO_BIN_EXE_restir-pt"));
+        if let Some(k) = task {
+            cmd.env("SLURM_ARRAY_TASK_ID", k.to_string());
+        }
+        let done = cmd.output().unwrap();
+        let stdout = String::from_utf8_lossy(&done.stdout).into_owned();
+        assert!(
+            done.status.success(),
+            "slurm.sh {args:?}: {}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+        stdout
+    };
+    let stdout = slurm_run(&["submit", s(&plan), "--partition=gpu"], None);
+    assert!(stdout.contains("submitted 2 jobs as array 4242 and the merge as 4242"), "{stdout}");
+    let calls = std::fs::read_to_string(&log).unwrap();
+    let calls: Vec<&str> = calls.lines().collect();
+    assert_eq!(calls.len(), 2, "{calls:?}");
+    assert!(
+        calls[0].starts_with("--parsable --array=0-1 --partition=gpu ") && calls[0].ends_with(&format!("job {}", s(&plan))),
+        "{calls:?}"
+    );
+    assert!(
+        calls[1].starts_with("--parsable --dependency=afterok:4242 --partition=gpu ") && calls[1].ends_with(&format!("merge {}", s(&plan))),
+        "{calls:?}"
+    );
+    for k in 0..2 {
+        slurm_run(&["job", s(&plan)], Some(k));
+    }
+    slurm_run(&["merge", s(&plan)], None);
+    assert_eq!(stability_one_process(), std::fs::read_to_string(out.join("stability.csv")).unwrap());
+}
+
+/// tools/cluster/ray_sweep.py on a local Ray instance with two workers runs the plan and the
+/// merge: stability.csv equal to one process's. Runs when the Python of $RESTIR_PT_PYTHON
+/// (default python3) imports ray (tools/setup.sh installs it); otherwise prints why it skipped.
+#[test]
+fn sweeps_ray_script_runs_a_plan_on_two_local_workers_and_merges() {
+    let python = std::env::var("RESTIR_PT_PYTHON").unwrap_or_else(|_| "python3".into());
+    let has_ray = Command::new(&python)
+        .args(["-c", "import ray"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_ray {
+        eprintln!("SKIPPED sweeps_ray_script_runs_a_plan_on_two_local_workers_and_merges: {python} cannot import ray (pip install ray, or set RESTIR_PT_PYTHON)");
+        return;
+    }
+    let out = fresh_dir("stability-ray");
+    let plan = stability_plan(&out);
+    let done = Command::new(&python)
+        .arg(script("ray_sweep.py"))
+        .arg(&plan)
+        .args(["--num-cpus", "2"])
+        .env("RESTIR_PT", env!("CARGO_BIN_EXE_restir-pt"))
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&done.stdout), String::from_utf8_lossy(&done.stderr));
+    assert!(done.status.success(), "ray_sweep.py: {stdout}{stderr}");
+    for k in 0..2 {
+        assert!(stdout.contains(&format!("job {k} of 2")), "{stdout}");
+    }
+    assert!(stdout.contains("2 jobs: wall"), "the merge ran: {stdout}");
+    assert_eq!(stability_one_process(), std::fs::read_to_string(out.join("stability.csv")).unwrap());
+    check_job_reports(&out.join("jobs"), 2);
 }
