@@ -7,7 +7,8 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 
-use super::compare::{measure, note_camera_path, write_csv, write_outputs, CompareArgs, CompareRow, Setup};
+use super::compare::{measure, note_camera_path, CompareArgs, CompareRow, Setup};
+use super::compare_outputs::{write_csv, write_outputs};
 use super::method_spec::MethodRenderer;
 use super::sweep::{
     devices, job_file, parse_optional, read_job_reports, read_job_rows, start_job, write_accounting, write_job_report, write_plan,

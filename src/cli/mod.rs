@@ -2,6 +2,7 @@
 
 mod bench;
 mod compare;
+mod compare_outputs;
 mod compare_sweep;
 mod info;
 mod method_spec;
@@ -13,7 +14,8 @@ mod stability;
 mod sweep;
 
 pub use bench::{bench, BenchArgs};
-pub use compare::{compare, equal_time_lines, CompareArgs, CompareRow};
+pub use compare::{compare, CompareArgs, CompareRow};
+pub use compare_outputs::equal_time_lines;
 pub use info::info;
 pub use method_spec::MethodSpec;
 pub use profile::{profile, ProfileArgs};

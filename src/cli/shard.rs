@@ -151,7 +151,7 @@ pub fn read_shard(path: &Path) -> Result<ShardSums> {
             .channel_data
             .list
             .iter()
-            .find(|c| c.name == Text::from(name))
+            .find(|c| c.name == *name)
             .ok_or_else(|| anyhow!("{}: not a reference shard (no channel {name})", path.display()))?;
         match &c.sample_data {
             FlatSamples::F32(v) if v.len() == pixels => Ok(v.clone()),

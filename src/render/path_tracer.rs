@@ -43,6 +43,9 @@ impl RenderStats {
     }
 }
 
+/// Per-pixel vec4 accumulations, row-major.
+pub type PixelSums = Vec<[f32; 4]>;
+
 pub struct PathTracer {
     ctx: Arc<Context>,
     kernel: Kernel,
@@ -228,7 +231,7 @@ impl PathTracer {
 
     /// The accumulation buffers as they are: per pixel `[sum r, sum g, sum b, samples]` and
     /// `[sum r^2, sum g^2, sum b^2, 0]` of the radiance of its paths, row-major.
-    pub fn sums(&self) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>)> {
+    pub fn sums(&self) -> Result<(PixelSums, PixelSums)> {
         let n = self.settings.pixel_count();
         Ok((self.accum.read(n)?, self.accum_sq.read(n)?))
     }
