@@ -138,6 +138,14 @@ impl MethodRenderer {
         }
     }
 
+    /// Building and compiling this renderer's kernels, in ms (`KernelCompile::total_ms`).
+    pub fn compile_ms(&self) -> f64 {
+        match self {
+            MethodRenderer::PathTracing(t, _) => t.compile_report().total_ms(),
+            MethodRenderer::Restir(r) => r.compile_reports().iter().map(|k| k.total_ms()).sum(),
+        }
+    }
+
     pub fn cost_knob_name(&self) -> &'static str {
         match self {
             MethodRenderer::PathTracing(..) => "spp",

@@ -50,6 +50,9 @@ impl RenderStats {
     }
 }
 
+/// Per-pixel vec4 accumulations, row-major.
+pub type PixelSums = Vec<[f32; 4]>;
+
 pub struct PathTracer {
     ctx: Arc<Context>,
     kernel: Kernel,
@@ -61,6 +64,9 @@ pub struct PathTracer {
     timer: PassTimer,
     settings: RenderSettings,
     base_params: crate::gpu_types::FrameParams,
+    /// Index of the first sample of this render in the (pixel, sample, seed) key of
+    /// `path_seed`; `samples_done` counts on from it.
+    first_sample: u32,
     samples_done: u32,
     counters: Option<TraversalCounters>,
 }
@@ -117,6 +123,7 @@ impl PathTracer {
             base_params: settings.frame_params(scene),
             settings: settings.clone(),
             _scene_gpu: scene_gpu,
+            first_sample: 0,
             samples_done: 0,
             counters: counters.then(TraversalCounters::default),
         })
@@ -139,6 +146,7 @@ impl PathTracer {
         self.accum_sq.fill(0)?;
         self.base_params = settings.frame_params(scene);
         self.settings = settings.clone();
+        self.first_sample = 0;
         self.samples_done = 0;
         if let Some(c) = self.counters.as_mut() {
             *c = TraversalCounters::default();
@@ -146,12 +154,19 @@ impl PathTracer {
         Ok(())
     }
 
+    /// Makes this render's samples the ones numbered `first`, `first + 1`, ... (up to
+    /// `first + spp`) of the same seed, so that renders of disjoint ranges are disjoint shares of
+    /// one render; `restart` goes back to 0. Call before the first dispatch.
+    pub fn start_at_sample(&mut self, first: u32) {
+        self.first_sample = first;
+    }
+
     /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the
     /// device has no timestamps), the most loop iterations any subgroup ran and the number of
     /// paths with a non-finite radiance or throughput.
     pub fn dispatch(&mut self, samples: u32) -> Result<(Option<f64>, u32, u32)> {
         let mut params = self.base_params;
-        params.sample_offset = self.samples_done;
+        params.sample_offset = self.first_sample + self.samples_done;
         params.samples_per_dispatch = samples;
         self.params.write(std::slice::from_ref(&params))?;
         let groups = [
@@ -242,6 +257,13 @@ impl PathTracer {
     /// What building and compiling the kernel cost.
     pub fn compile_report(&self) -> &KernelCompile {
         self.kernel.compile_report()
+    }
+
+    /// The accumulation buffers as they are: per pixel `[sum r, sum g, sum b, samples]` and
+    /// `[sum r^2, sum g^2, sum b^2, 0]` of the radiance of its paths, row-major.
+    pub fn sums(&self) -> Result<(PixelSums, PixelSums)> {
+        let n = self.settings.pixel_count();
+        Ok((self.accum.read(n)?, self.accum_sq.read(n)?))
     }
 
     pub fn image(&self) -> Result<Image> {
