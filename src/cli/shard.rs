@@ -246,6 +246,11 @@ pub fn merge(shards: &[PathBuf], out: &Path, allow_nonfinite: bool) -> Result<()
             "warning: shards {missing:?} of {} are missing: the reference has {} of {} spp",
             meta.shards, meta.spp, meta.total_spp
         );
+    } else if meta.spp != meta.total_spp {
+        eprintln!(
+            "warning: the shards hold {} of {} spp (was a shard interrupted?)",
+            meta.spp, meta.total_spp
+        );
     }
     let image = Image::from_sums(meta.width, meta.height, &merged.sums, &merged.sums_sq);
     let nonfinite = image.non_finite_count();
