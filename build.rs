@@ -21,7 +21,36 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<(String, PathBuf)>) {
     }
 }
 
+/// `git rev-parse --short HEAD` of the crate, or "unknown" without git or outside a repository;
+/// rebuilds when HEAD moves.
+fn embed_commit() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .and_then(|o| String::from_utf8(o.stdout).ok())
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+    };
+    let commit = git(&["rev-parse", "--short", "HEAD"]).unwrap_or_else(|| "unknown".into());
+    println!("cargo:rustc-env=RESTIR_PT_COMMIT={commit}");
+    let head_ref = git(&["symbolic-ref", "-q", "HEAD"]);
+    for name in ["HEAD", "packed-refs"].into_iter().map(String::from).chain(head_ref) {
+        if let Some(path) = git(&["rev-parse", "--git-path", &name]) {
+            let path = Path::new(dir).join(path);
+            if path.exists() {
+                println!("cargo:rerun-if-changed={}", path.display());
+            }
+        }
+    }
+}
+
 fn main() {
+    embed_commit();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
     println!("cargo:rerun-if-changed=glsl");
     let mut files = Vec::new();

@@ -14,6 +14,7 @@ layout(std430, set = 0, binding = 7) buffer Status {
     uint max_loop_iterations;
     uint loop_budget_cut_groups;
     uint nonfinite_paths;           // paths whose radiance or throughput is NaN or infinite
+    uint status_pad;                // std430 aligns the uvec2 array below to 8 bytes
     uvec2 counters[COUNTER_COUNT];  // 64-bit totals (low, high) of counters.glsl
     uint subgroup_lanes;
 };

@@ -33,6 +33,9 @@ enum Command {
     Bench(BenchCmd),
     /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
     Reference(ReferenceCmd),
+    /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out) and variance
+    /// EXR (<out>.variance.exr) one `reference` process of the same seed and spp writes.
+    Merge(MergeCmd),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
     Profile(ProfileCmd),
     /// Error against GPU time per frame for each method at equal time budgets, against a
@@ -285,8 +288,25 @@ struct ReferenceCmd {
     /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
     #[arg(long)]
     allow_nonfinite: bool,
+    /// Render only share I of N (0-based) of the --spp samples, disjoint from the other shares,
+    /// and write their per-pixel sums to --out as a shard EXR for `merge`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
     #[command(flatten)]
     device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct MergeCmd {
+    /// Shard EXRs written by `reference --shard I/N`.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    #[arg(long)]
+    out: PathBuf,
+    /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
+    #[arg(long)]
+    allow_nonfinite: bool,
 }
 
 #[derive(Args)]
@@ -352,6 +372,8 @@ struct CompareCmd {
     #[arg(long, default_value = "out/compare")]
     out_dir: PathBuf,
     #[command(flatten)]
+    sweep: SweepOpts,
+    #[command(flatten)]
     device: DeviceOpts,
 }
 
@@ -384,7 +406,36 @@ struct StabilityCmd {
     #[arg(long, default_value = "out/stability")]
     out_dir: PathBuf,
     #[command(flatten)]
+    sweep: SweepOpts,
+    #[command(flatten)]
     device: DeviceOpts,
+}
+
+#[derive(Args)]
+struct SweepOpts {
+    /// Write the runs as a job list (JSON lines: each job's command and working folder) to
+    /// this file and run nothing; see tools/cluster/.
+    #[arg(long, value_name = "JOBS.jsonl")]
+    plan: Option<PathBuf>,
+    /// Run only job K (0-based) of the job list these arguments make; it writes
+    /// <out-dir>/jobs/job_K.csv/.json.
+    #[arg(long, value_name = "K")]
+    job: Option<usize>,
+    /// Merge the jobs' files in DIR (normally <out-dir>/jobs) into the usual outputs and
+    /// accounting.csv.
+    #[arg(long, value_name = "DIR")]
+    merge: Option<PathBuf>,
+}
+
+impl SweepOpts {
+    fn mode(self) -> anyhow::Result<cli::SweepMode> {
+        cli::SweepMode::from_flags(self.plan, self.job, self.merge)
+    }
+}
+
+/// The command line after the program name, for job lists.
+fn argv() -> Vec<String> {
+    std::env::args_os().skip(1).map(|a| a.to_string_lossy().into_owned()).collect()
 }
 
 impl From<DeviceOpts> for DeviceArgs {
@@ -460,18 +511,22 @@ fn main() -> ExitCode {
             };
             cli::info(&i.scene, &load, kernels)
         }
-        Command::Reference(r) => cli::reference(cli::ReferenceArgs {
-            scene: r.scene,
-            spp: r.spp,
-            width: r.width,
-            height: r.height,
-            max_depth: r.max_depth,
-            camera: r.camera,
-            seed: r.seed,
-            out: r.out,
-            allow_nonfinite: r.allow_nonfinite,
-            device: r.device.into(),
+        Command::Reference(r) => r.shard.as_deref().map(cli::ShardSpec::parse).transpose().and_then(|shard| {
+            cli::reference(cli::ReferenceArgs {
+                scene: r.scene,
+                spp: r.spp,
+                width: r.width,
+                height: r.height,
+                max_depth: r.max_depth,
+                camera: r.camera,
+                seed: r.seed,
+                out: r.out,
+                allow_nonfinite: r.allow_nonfinite,
+                shard,
+                device: r.device.into(),
+            })
         }),
+        Command::Merge(m) => cli::merge(&m.shards, &m.out, m.allow_nonfinite),
         Command::Profile(p) => cli::profile(cli::ProfileArgs {
             restir: p.restir.settings(),
             scene: p.scene,
@@ -484,37 +539,51 @@ fn main() -> ExitCode {
             out_dir: p.out_dir,
             device: p.device.into(),
         }),
-        Command::Compare(c) => cli::compare(cli::CompareArgs {
-            restir: c.restir.settings(),
-            scene: c.scene,
-            reference: c.reference,
-            methods: c.methods,
-            budgets_ms: c.budgets_ms,
-            frames: c.frames,
-            camera_path: c.camera_path,
-            trials: c.trials,
-            max_depth: c.max_depth,
-            camera: c.camera,
-            seed: c.seed,
-            out_dir: c.out_dir,
-            device: c.device.into(),
-        })
-        .map(|_| ()),
-        Command::Stability(s) => cli::stability(cli::StabilityArgs {
-            restir: s.restir.settings(),
-            scenes: s.scenes,
-            methods: s.methods,
-            frames: s.frames,
-            width: s.width,
-            height: s.height,
-            max_depth: s.max_depth,
-            reference_spp: s.reference_spp,
-            pt_spp: s.pt_spp,
-            seed: s.seed,
-            out_dir: Some(s.out_dir),
-            device: s.device.into(),
-        })
-        .map(|_| ()),
+        Command::Compare(c) => c
+            .sweep
+            .mode()
+            .and_then(|sweep| {
+                cli::compare(cli::CompareArgs {
+                    restir: c.restir.settings(),
+                    scene: c.scene,
+                    reference: c.reference,
+                    methods: c.methods,
+                    budgets_ms: c.budgets_ms,
+                    frames: c.frames,
+                    camera_path: c.camera_path,
+                    trials: c.trials,
+                    max_depth: c.max_depth,
+                    camera: c.camera,
+                    seed: c.seed,
+                    out_dir: c.out_dir,
+                    sweep,
+                    argv: argv(),
+                    device: c.device.into(),
+                })
+            })
+            .map(|_| ()),
+        Command::Stability(s) => s
+            .sweep
+            .mode()
+            .and_then(|sweep| {
+                cli::stability(cli::StabilityArgs {
+                    restir: s.restir.settings(),
+                    scenes: s.scenes,
+                    methods: s.methods,
+                    frames: s.frames,
+                    width: s.width,
+                    height: s.height,
+                    max_depth: s.max_depth,
+                    reference_spp: s.reference_spp,
+                    pt_spp: s.pt_spp,
+                    seed: s.seed,
+                    out_dir: Some(s.out_dir),
+                    sweep,
+                    argv: argv(),
+                    device: s.device.into(),
+                })
+            })
+            .map(|_| ()),
         Command::Bench(b) => cli::bench(cli::BenchArgs {
             scene: b.scene,
             width: b.width,

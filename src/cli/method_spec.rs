@@ -17,17 +17,28 @@ pub enum MethodSpec {
 }
 
 impl MethodSpec {
-    /// Parses `pt`, `restir` (the default hybrid shift), `restir:SHIFT` or `restir:SHIFT/MIS`;
-    /// unnamed ReSTIR settings come from `base`.
+    /// Parses `pt`, `restir` (the default hybrid shift), `restir:SHIFT` or `restir:SHIFT/MIS`,
+    /// each ReSTIR form optionally followed by `@sK` for K spatial neighbours (`@s0`: spatial
+    /// reuse off); unnamed ReSTIR settings come from `base`.
     pub fn parse(text: &str, base: &RestirSettings) -> Result<Self> {
         let text = text.trim();
         if text == "pt" {
             return Ok(MethodSpec::PathTracing);
         }
         let Some(rest) = text.strip_prefix("restir") else {
-            bail!("method '{text}': expected pt or restir:reconnection|replay|hybrid[/gbh|pairwise]");
+            bail!("method '{text}': expected pt or restir:reconnection|replay|hybrid[/gbh|pairwise][@sK]");
         };
         let mut settings = base.clone();
+        let rest = match rest.split_once('@') {
+            Some((r, spatial)) => {
+                settings.spatial = spatial
+                    .strip_prefix('s')
+                    .and_then(|k| k.parse().ok())
+                    .ok_or_else(|| anyhow::anyhow!("method '{text}': expected @sK, K spatial neighbours"))?;
+                r
+            }
+            None => rest,
+        };
         let rest = match rest.strip_prefix(':') {
             Some(r) => r,
             None if rest.is_empty() => return Ok(MethodSpec::Restir(settings)),
@@ -127,6 +138,14 @@ impl MethodRenderer {
         }
     }
 
+    /// Building and compiling this renderer's kernels, in ms (`KernelCompile::total_ms`).
+    pub fn compile_ms(&self) -> f64 {
+        match self {
+            MethodRenderer::PathTracing(t, _) => t.compile_report().total_ms(),
+            MethodRenderer::Restir(r) => r.compile_reports().iter().map(|k| k.total_ms()).sum(),
+        }
+    }
+
     pub fn cost_knob_name(&self) -> &'static str {
         match self {
             MethodRenderer::PathTracing(..) => "spp",
@@ -166,5 +185,30 @@ impl MethodRenderer {
                 Ok((outcome, r.image()?))
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_spec_parses_shift_mis_and_spatial_neighbours() {
+        let base = RestirSettings::default();
+        let MethodSpec::Restir(r) = MethodSpec::parse("restir:reconnection/pairwise@s0", &base).unwrap() else {
+            panic!("a ReSTIR method")
+        };
+        assert_eq!((r.shift, r.mis, r.spatial), (ShiftKind::Reconnection, ReuseMis::Pairwise, 0));
+        assert_eq!(r.label(), "restir:reconnection/pairwise@s0");
+        let MethodSpec::Restir(r) = MethodSpec::parse("restir@s5", &base).unwrap() else {
+            panic!("a ReSTIR method")
+        };
+        assert_eq!((r.shift, r.spatial), (base.shift, 5));
+        assert_eq!(MethodSpec::parse("restir", &base).unwrap().label(), base.label());
+        assert!(!base.label().contains('@'));
+        for bad in ["restir@x", "restir:hybrid@s", "restir@s-1", "restir:warp"] {
+            assert!(MethodSpec::parse(bad, &base).is_err(), "{bad}");
+        }
+        assert_eq!(MethodSpec::parse(" pt ", &base).unwrap(), MethodSpec::PathTracing);
     }
 }

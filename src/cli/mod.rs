@@ -2,20 +2,27 @@
 
 mod bench;
 mod compare;
+mod compare_outputs;
+mod compare_sweep;
 mod info;
 mod method_spec;
 mod profile;
 mod reference;
 mod render;
+mod shard;
 mod stability;
+mod sweep;
 
 pub use bench::{bench, BenchArgs};
-pub use compare::{compare, equal_time_lines, CompareArgs, CompareRow};
+pub use compare::{compare, CompareArgs, CompareRow};
+pub use compare_outputs::equal_time_lines;
 pub use info::info;
 pub use method_spec::MethodSpec;
 pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, Method, RenderArgs};
+pub use shard::{merge, merge_shards, read_shard, ShardMeta, ShardSpec, ShardSums};
+pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
 pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
 
 use std::path::{Path, PathBuf};

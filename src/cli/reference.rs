@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 
 use super::render::{interrupt_flag, progress_bar};
+use super::shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::image_io::write_exr;
 use crate::render::{PathTracer, RenderSettings};
@@ -20,6 +21,9 @@ pub struct ReferenceArgs {
     pub out: PathBuf,
     /// Write a reference with non-finite pixels (with a warning) instead of failing.
     pub allow_nonfinite: bool,
+    /// Render only this share of the `spp` samples and write their sums to `out` (a shard EXR,
+    /// see `shard.rs`) instead of the mean and variance.
+    pub shard: Option<ShardSpec>,
     pub device: DeviceArgs,
 }
 
@@ -31,10 +35,18 @@ pub fn variance_path(out: &std::path::Path) -> PathBuf {
 pub fn reference(args: ReferenceArgs) -> Result<()> {
     let path = scene_path(Some(&args.scene));
     let scene = load_with_warnings(&path)?;
+    let samples = args.shard.map(|s| s.samples(args.spp)).unwrap_or(0..args.spp);
+    if samples.is_empty() {
+        bail!(
+            "--spp {} cannot be cut into {} shards: each needs at least 1 sample",
+            args.spp,
+            args.shard.map_or(1, |s| s.count)
+        );
+    }
     let settings = RenderSettings {
         width: args.width,
         height: args.height,
-        spp: args.spp,
+        spp: samples.len() as u32,
         max_depth: args.max_depth,
         seed: args.seed,
         camera: args.camera,
@@ -44,6 +56,7 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
     super::render::create_parent(&args.out)?;
     let ctx = open_device(&args.device)?;
     let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
+    tracer.start_at_sample(samples.start);
     let bar = progress_bar(settings.spp);
     let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt_flag())?;
     bar.finish_and_clear();
@@ -60,8 +73,26 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
         eprintln!("warning: {what}; writing the reference anyway (--allow-nonfinite)");
     }
     let variance = variance_path(&args.out);
-    write_exr(&args.out, image.width, image.height, &image.mean)?;
-    write_exr(&variance, image.width, image.height, &image.variance)?;
+    if let Some(shard) = args.shard {
+        let (sums, sums_sq) = tracer.sums()?;
+        let meta = ShardMeta {
+            scene: path.display().to_string(),
+            width: settings.width,
+            height: settings.height,
+            max_depth: settings.max_depth,
+            camera: settings.camera,
+            seed: settings.seed,
+            total_spp: args.spp,
+            shard: shard.index,
+            shards: shard.count,
+            first_sample: samples.start,
+            spp: stats.spp,
+        };
+        write_shard(&args.out, &ShardSums { meta, sums, sums_sq })?;
+    } else {
+        write_exr(&args.out, image.width, image.height, &image.mean)?;
+        write_exr(&variance, image.width, image.height, &image.variance)?;
+    }
     drop(tracer);
     finish_device(&ctx)?;
     println!(
@@ -74,6 +105,17 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
         stats.gpu_ms,
         if stats.interrupted { " | interrupted" } else { "" }
     );
-    eprintln!("wrote {} and {}", args.out.display(), variance.display());
+    match args.shard {
+        Some(s) => eprintln!(
+            "wrote shard {}/{} (samples {}..{} of {}) to {}",
+            s.index,
+            s.count,
+            samples.start,
+            samples.end,
+            args.spp,
+            args.out.display()
+        ),
+        None => eprintln!("wrote {} and {}", args.out.display(), variance.display()),
+    }
     Ok(())
 }

@@ -7,16 +7,23 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use glam::Vec3;
 
 use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
+use super::sweep::{
+    job_file, parse_optional, read_job_reports, read_job_rows, start_job, write_accounting, write_job_report, write_plan, JobReport,
+    SweepMode, COMMIT,
+};
 use super::{bundled_file, finish_device, load_with_warnings, open_device, DeviceArgs};
 use crate::charts::{write_line_chart, LineChart, Series};
 use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
 use crate::render::{PathTracer, RenderSettings, RestirSettings};
 use crate::scene::{camera_on_path, Scene};
+use crate::vk::Context;
 
 pub struct StabilityArgs {
     pub scenes: Vec<PathBuf>,
@@ -33,6 +40,11 @@ pub struct StabilityArgs {
     pub restir: RestirSettings,
     /// Folder for stability.csv and the charts; None writes nothing.
     pub out_dir: Option<PathBuf>,
+    /// One process for everything, or a job list (one job per scene and method), one job of
+    /// it, or the merge of its jobs; all but the first need `out_dir`.
+    pub sweep: SweepMode,
+    /// The command line after `restir-pt` (for the job list's commands).
+    pub argv: Vec<String>,
     pub device: DeviceArgs,
 }
 
@@ -81,6 +93,8 @@ struct References<'a> {
     scene: &'a Scene,
     settings: RenderSettings,
     images: HashMap<usize, Vec<Vec3>>,
+    /// GPU ms of the references rendered.
+    gpu_ms: f64,
 }
 
 impl References<'_> {
@@ -91,7 +105,7 @@ impl References<'_> {
                 ..self.settings.clone()
             };
             self.tracer.restart(self.scene, &settings)?;
-            self.tracer.render(&|_| {}, &AtomicBool::new(false))?;
+            self.gpu_ms += self.tracer.render(&|_| {}, &AtomicBool::new(false))?.gpu_ms;
             self.images.insert(camera, self.tracer.image()?.mean);
         }
         Ok(&self.images[&camera])
@@ -112,7 +126,40 @@ pub fn bundled_scene_paths() -> Vec<PathBuf> {
         .collect()
 }
 
-pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
+/// The scenes, methods and settings every mode checks before it opens a device.
+struct Setup {
+    methods: Vec<MethodSpec>,
+    scenes: Vec<(String, Scene)>,
+    base: RenderSettings,
+}
+
+impl Setup {
+    /// Path-traced references of `scene`'s poses, rendered on first use.
+    fn references<'a>(&self, ctx: &Arc<Context>, args: &StabilityArgs, scene: &'a Scene) -> Result<References<'a>> {
+        let settings = RenderSettings {
+            spp: args.reference_spp,
+            seed: args.seed ^ 0x5eed_0f5e,
+            ..self.base.clone()
+        };
+        Ok(References {
+            tracer: PathTracer::new(ctx, scene, &settings)?,
+            scene,
+            settings,
+            images: HashMap::new(),
+            gpu_ms: 0.0,
+        })
+    }
+
+    /// The jobs: every method on every scene, scene-major.
+    fn labels(&self) -> Vec<String> {
+        self.scenes
+            .iter()
+            .flat_map(|(name, _)| self.methods.iter().map(move |m| format!("{name} {}", m.label())))
+            .collect()
+    }
+}
+
+fn setup(args: &StabilityArgs) -> Result<Setup> {
     if args.frames < 2 {
         bail!("--frames must be at least 2 (flicker compares consecutive frames)");
     }
@@ -120,15 +167,11 @@ pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
         bail!("--reference-spp and --pt-spp must be at least 1");
     }
     let methods = parse_methods(&args.methods, &args.restir)?;
-    let scenes = if args.scenes.is_empty() {
+    let paths = if args.scenes.is_empty() {
         bundled_scene_paths()
     } else {
         args.scenes.clone()
     };
-    let loaded: Vec<(PathBuf, Scene)> = scenes
-        .iter()
-        .map(|p| Ok((p.clone(), load_with_warnings(p)?)))
-        .collect::<Result<_>>()?;
     let base = RenderSettings {
         width: args.width,
         height: args.height,
@@ -136,8 +179,11 @@ pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
         seed: args.seed,
         ..Default::default()
     };
-    for (path, scene) in &loaded {
-        base.validate(scene).with_context(|| path.display().to_string())?;
+    let mut scenes = vec![];
+    for path in &paths {
+        let scene = load_with_warnings(path)?;
+        base.validate(&scene).with_context(|| path.display().to_string())?;
+        scenes.push((scene_name(path), scene));
     }
     for m in &methods {
         if let MethodSpec::Restir(r) = m {
@@ -147,70 +193,168 @@ pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
     if let Some(dir) = &args.out_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     }
-    let ctx = open_device(&args.device)?;
-    let mut rows = vec![];
-    for (path, scene) in &loaded {
-        let name = scene_name(path);
-        let reference_settings = RenderSettings {
-            spp: args.reference_spp,
-            seed: args.seed ^ 0x5eed_0f5e,
-            ..base.clone()
-        };
-        let mut references = References {
-            tracer: PathTracer::new(&ctx, scene, &reference_settings)?,
-            scene,
-            settings: reference_settings,
-            images: HashMap::new(),
-        };
-        let mut scene_rows = vec![];
-        for method in &methods {
-            let settings = RenderSettings {
-                spp: args.pt_spp,
-                ..base.clone()
-            };
-            let mut renderer = MethodRenderer::new(&ctx, scene, &settings, method)?;
-            for motion in [CameraMotion::Static, CameraMotion::Moving] {
-                renderer.reset(scene, &settings)?;
-                let mut previous: Option<Vec<Vec3>> = None;
-                for frame in 0..args.frames {
-                    let camera = motion.camera(frame, scene.cameras.len());
-                    let (outcome, image) = renderer.frame(scene, &settings, camera, frame)?;
-                    let reference = references.get(camera)?;
-                    let row = StabilityRow {
-                        scene: name.clone(),
-                        method: method.label(),
-                        motion,
-                        frame,
-                        nonfinite_pixels: image.non_finite_count(),
-                        energy_ratio: energy_ratio(&image.mean, reference),
-                        rel_mse: rel_mse(&image.mean, reference),
-                        flicker: match (motion, &previous) {
-                            (CameraMotion::Static, Some(p)) => Some(flicker(p, &image.mean, reference)),
-                            _ => None,
-                        },
-                        failed_shift_rate: outcome.failed_shift_rate,
-                    };
-                    previous = Some(image.mean);
-                    scene_rows.push(row);
+    Ok(Setup { methods, scenes, base })
+}
+
+pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
+    let setup = setup(&args)?;
+    let out_dir = match (&args.sweep, &args.out_dir) {
+        (SweepMode::All, _) => None,
+        (_, Some(dir)) => Some(dir),
+        (_, None) => bail!("--plan, --job and --merge need an output folder"),
+    };
+    let rows = match (&args.sweep, out_dir) {
+        (SweepMode::Plan(plan), Some(dir)) => {
+            write_plan(plan, &args.argv, &setup.labels(), dir)?;
+            return Ok(vec![]);
+        }
+        (SweepMode::Job(k), Some(dir)) => return run_job(&args, &setup, *k, dir),
+        (SweepMode::Merge(jobs), Some(dir)) => merge(&setup, jobs, dir)?,
+        _ => {
+            let ctx = open_device(&args.device)?;
+            let mut rows = vec![];
+            for (name, scene) in &setup.scenes {
+                let mut references = setup.references(&ctx, &args, scene)?;
+                for method in &setup.methods {
+                    rows.extend(run_method(&ctx, &args, &setup, name, scene, method, &mut references)?.0);
                 }
             }
+            finish_device(&ctx)?;
+            rows
         }
-        print_summary(&scene_rows, &methods);
-        if let Some(dir) = &args.out_dir {
-            write_chart(dir, &name, &scene_rows, &methods)?;
+    };
+    write_results(&args, &setup, &rows)?;
+    Ok(rows)
+}
+
+/// One method on one scene, static then moving camera. Returns the rows, their GPU ms and the
+/// renderer's kernel compile ms.
+fn run_method(
+    ctx: &Arc<Context>,
+    args: &StabilityArgs,
+    setup: &Setup,
+    name: &str,
+    scene: &Scene,
+    method: &MethodSpec,
+    references: &mut References,
+) -> Result<(Vec<StabilityRow>, f64, f64)> {
+    let settings = RenderSettings {
+        spp: args.pt_spp,
+        ..setup.base.clone()
+    };
+    let mut renderer = MethodRenderer::new(ctx, scene, &settings, method)?;
+    let (mut rows, mut gpu_ms) = (vec![], 0.0);
+    for motion in [CameraMotion::Static, CameraMotion::Moving] {
+        renderer.reset(scene, &settings)?;
+        let mut previous: Option<Vec<Vec3>> = None;
+        for frame in 0..args.frames {
+            let camera = motion.camera(frame, scene.cameras.len());
+            let (outcome, image) = renderer.frame(scene, &settings, camera, frame)?;
+            gpu_ms += outcome.gpu_ms;
+            let reference = references.get(camera)?;
+            rows.push(StabilityRow {
+                scene: name.to_string(),
+                method: method.label(),
+                motion,
+                frame,
+                nonfinite_pixels: image.non_finite_count(),
+                energy_ratio: energy_ratio(&image.mean, reference),
+                rel_mse: rel_mse(&image.mean, reference),
+                flicker: match (motion, &previous) {
+                    (CameraMotion::Static, Some(p)) => Some(flicker(p, &image.mean, reference)),
+                    _ => None,
+                },
+                failed_shift_rate: outcome.failed_shift_rate,
+            });
+            previous = Some(image.mean);
         }
-        rows.extend(scene_rows);
     }
+    Ok((rows, gpu_ms, renderer.compile_ms()))
+}
+
+/// Job K: method K % methods on scene K / methods, into `<out_dir>/jobs/job_K.csv/.json`.
+fn run_job(args: &StabilityArgs, setup: &Setup, k: usize, out_dir: &Path) -> Result<Vec<StabilityRow>> {
+    let labels = setup.labels();
+    let dir = start_job(k, labels.len(), out_dir)?;
+    let start = Instant::now();
+    let (name, scene) = &setup.scenes[k / setup.methods.len()];
+    let method = &setup.methods[k % setup.methods.len()];
+    let ctx = open_device(&args.device)?;
+    let mut references = setup.references(&ctx, args, scene)?;
+    let (rows, gpu_ms, compile_ms) = run_method(&ctx, args, setup, name, scene, method, &mut references)?;
+    let report = JobReport {
+        job: k,
+        jobs: labels.len(),
+        label: labels[k].clone(),
+        device: ctx.info.name.clone(),
+        commit: COMMIT.to_string(),
+        wall_ms: 0.0,
+        gpu_ms: gpu_ms + references.gpu_ms,
+        compile_ms: compile_ms + references.tracer.compile_report().total_ms(),
+    };
+    drop(references);
     finish_device(&ctx)?;
+    write_csv(&job_file(&dir, k, "csv"), &rows)?;
+    write_job_report(
+        &dir,
+        &JobReport {
+            wall_ms: start.elapsed().as_secs_f64() * 1e3,
+            ..report
+        },
+    )?;
+    Ok(rows)
+}
+
+fn merge(setup: &Setup, jobs_dir: &Path, out_dir: &Path) -> Result<Vec<StabilityRow>> {
+    let jobs = setup.labels().len();
+    let reports = read_job_reports(jobs_dir, jobs)?;
+    let rows = read_job_rows(jobs_dir, jobs, HEADER)?
+        .into_iter()
+        .map(|(_, path, fields)| parse_row(&fields).with_context(|| format!("{}: a row that is not {HEADER}", path.display())))
+        .collect::<Result<Vec<_>>>()?;
+    write_accounting(out_dir, &reports)?;
+    Ok(rows)
+}
+
+/// Summaries, charts and stability.csv of all rows; fails if any pixel was not finite.
+fn write_results(args: &StabilityArgs, setup: &Setup, rows: &[StabilityRow]) -> Result<()> {
+    for (name, _) in &setup.scenes {
+        let scene_rows: Vec<StabilityRow> = rows.iter().filter(|r| r.scene == *name).cloned().collect();
+        print_summary(&scene_rows, &setup.methods);
+        if let Some(dir) = &args.out_dir {
+            write_chart(dir, name, &scene_rows, &setup.methods)?;
+        }
+    }
     if let Some(dir) = &args.out_dir {
-        write_csv(&dir.join("stability.csv"), &rows)?;
+        write_csv(&dir.join("stability.csv"), rows)?;
         eprintln!("wrote stability.csv and <scene>_rel_mse.svg/png in {}", dir.display());
     }
     let nonfinite: usize = rows.iter().map(|r| r.nonfinite_pixels).sum();
     if nonfinite > 0 {
         bail!("{nonfinite} non-finite pixels over all frames (see the summary above)");
     }
-    Ok(rows)
+    Ok(())
+}
+
+fn parse_row(f: &[String]) -> Result<StabilityRow> {
+    if f.len() != HEADER.split(',').count() {
+        bail!("{} fields", f.len());
+    }
+    Ok(StabilityRow {
+        scene: f[0].clone(),
+        method: f[1].clone(),
+        motion: match f[2].as_str() {
+            "static" => CameraMotion::Static,
+            "moving" => CameraMotion::Moving,
+            other => bail!("camera '{other}'"),
+        },
+        frame: f[3].parse()?,
+        nonfinite_pixels: f[4].parse()?,
+        energy_ratio: f[5].parse()?,
+        rel_mse: f[6].parse()?,
+        flicker: parse_optional(&f[7])?,
+        failed_shift_rate: parse_optional(&f[8])?,
+    })
 }
 
 /// One line per method and camera motion.
@@ -275,8 +419,10 @@ fn write_chart(dir: &Path, scene: &str, rows: &[StabilityRow], methods: &[Method
     )
 }
 
+const HEADER: &str = "scene,method,camera,frame,nonfinite_pixels,energy_ratio,rel_mse,flicker,failed_shift_rate";
+
 fn write_csv(path: &Path, rows: &[StabilityRow]) -> Result<()> {
-    let mut csv = String::from("scene,method,camera,frame,nonfinite_pixels,energy_ratio,rel_mse,flicker,failed_shift_rate\n");
+    let mut csv = format!("{HEADER}\n");
     let optional = |v: Option<f64>| v.map(|x| format!("{x:.6}")).unwrap_or_default();
     for r in rows {
         let _ = writeln!(

@@ -23,9 +23,11 @@ const MAX_CHUNK_GROWTH: u32 = 8;
 /// pixels whose paths cost more than the ones measured so far.
 const LOOP_BUDGET_SHARE: f64 = 0.25;
 /// Words of glsl/pathtrace.comp's Status block: max loop iterations, subgroups with a cut loop,
-/// paths with a non-finite radiance or throughput, the 64-bit profile counters and the subgroup
-/// size.
-const STATUS_WORDS: u64 = 4 + 2 * COUNTER_COUNT as u64;
+/// paths with a non-finite radiance or throughput, a pad word (the counters are 8-byte aligned),
+/// the 64-bit profile counters and the subgroup size.
+const STATUS_WORDS: u64 = 5 + 2 * COUNTER_COUNT as u64;
+/// The first word of the profile counters in the Status block.
+const COUNTER_WORDS_START: usize = 4;
 const LOCAL_SIZE: u32 = 8;
 
 pub struct RenderStats {
@@ -48,6 +50,9 @@ impl RenderStats {
     }
 }
 
+/// Per-pixel vec4 accumulations, row-major.
+pub type PixelSums = Vec<[f32; 4]>;
+
 pub struct PathTracer {
     ctx: Arc<Context>,
     kernel: Kernel,
@@ -59,6 +64,9 @@ pub struct PathTracer {
     timer: PassTimer,
     settings: RenderSettings,
     base_params: crate::gpu_types::FrameParams,
+    /// Index of the first sample of this render in the (pixel, sample, seed) key of
+    /// `path_seed`; `samples_done` counts on from it.
+    first_sample: u32,
     samples_done: u32,
     counters: Option<TraversalCounters>,
 }
@@ -115,6 +123,7 @@ impl PathTracer {
             base_params: settings.frame_params(scene),
             settings: settings.clone(),
             _scene_gpu: scene_gpu,
+            first_sample: 0,
             samples_done: 0,
             counters: counters.then(TraversalCounters::default),
         })
@@ -137,6 +146,7 @@ impl PathTracer {
         self.accum_sq.fill(0)?;
         self.base_params = settings.frame_params(scene);
         self.settings = settings.clone();
+        self.first_sample = 0;
         self.samples_done = 0;
         if let Some(c) = self.counters.as_mut() {
             *c = TraversalCounters::default();
@@ -144,12 +154,19 @@ impl PathTracer {
         Ok(())
     }
 
+    /// Makes this render's samples the ones numbered `first`, `first + 1`, ... (up to
+    /// `first + spp`) of the same seed, so that renders of disjoint ranges are disjoint shares of
+    /// one render; `restart` goes back to 0. Call before the first dispatch.
+    pub fn start_at_sample(&mut self, first: u32) {
+        self.first_sample = first;
+    }
+
     /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the
     /// device has no timestamps), the most loop iterations any subgroup ran and the number of
     /// paths with a non-finite radiance or throughput.
     pub fn dispatch(&mut self, samples: u32) -> Result<(Option<f64>, u32, u32)> {
         let mut params = self.base_params;
-        params.sample_offset = self.samples_done;
+        params.sample_offset = self.first_sample + self.samples_done;
         params.samples_per_dispatch = samples;
         self.params.write(std::slice::from_ref(&params))?;
         let groups = [
@@ -180,7 +197,7 @@ impl PathTracer {
         }
         self.samples_done += samples;
         if let Some(c) = self.counters.as_mut() {
-            let words = &status[3..];
+            let words = &status[COUNTER_WORDS_START..];
             c.add(&TraversalCounters::from_words(words, words[2 * COUNTER_COUNT]));
         }
         Ok((self.timer.read_ms(1)?.map(|t| t[0]), iterations, nonfinite))
@@ -240,6 +257,13 @@ impl PathTracer {
     /// What building and compiling the kernel cost.
     pub fn compile_report(&self) -> &KernelCompile {
         self.kernel.compile_report()
+    }
+
+    /// The accumulation buffers as they are: per pixel `[sum r, sum g, sum b, samples]` and
+    /// `[sum r^2, sum g^2, sum b^2, 0]` of the radiance of its paths, row-major.
+    pub fn sums(&self) -> Result<(PixelSums, PixelSums)> {
+        let n = self.settings.pixel_count();
+        Ok((self.accum.read(n)?, self.accum_sq.read(n)?))
     }
 
     pub fn image(&self) -> Result<Image> {

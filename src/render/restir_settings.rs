@@ -162,8 +162,14 @@ impl RestirSettings {
         [("SHIFT_MODE", self.shift.define()), ("MIS_MODE", self.mis.define())]
     }
 
-    /// A short label such as `restir:hybrid/gbh`.
+    /// A short label such as `restir:hybrid/gbh`, with `@sK` when the spatial neighbours are not
+    /// the default's.
     pub fn label(&self) -> String {
-        format!("restir:{}/{}", self.shift.name(), self.mis.name())
+        let spatial = if self.spatial == RestirSettings::default().spatial {
+            String::new()
+        } else {
+            format!("@s{}", self.spatial)
+        };
+        format!("restir:{}/{}{spatial}", self.shift.name(), self.mis.name())
     }
 }

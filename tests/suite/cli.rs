@@ -240,7 +240,8 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
         assert!(last.contains(needle), "{needle} missing: {last}");
     }
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    assert_eq!(json["method"], "restir:reconnection/pairwise");
+    // --spatial 2 is not the default, so the label names it.
+    assert_eq!(json["method"], "restir:reconnection/pairwise@s2");
     assert!(json["restir"]["shifts_attempted"].as_u64().unwrap() > 0, "{json}");
     assert!(exr.exists());
     assert_clean_failure(&["render", "--spp", "4"], &["--spp", "ReSTIR"]);

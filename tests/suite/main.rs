@@ -24,4 +24,5 @@ mod scene_loader;
 mod scenes;
 mod shift;
 mod speed_accuracy;
+mod sweeps;
 mod trace_pair_oracle;

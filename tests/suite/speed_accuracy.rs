@@ -2,7 +2,7 @@
 //! energy within 2% of the references) and `compare`'s files.
 
 use glam::Vec3;
-use restir_pt::cli::{equal_time_lines, stability, CameraMotion, CompareRow, DeviceArgs, StabilityArgs};
+use restir_pt::cli::{equal_time_lines, stability, CameraMotion, CompareRow, DeviceArgs, StabilityArgs, SweepMode};
 use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
 use restir_pt::render::RestirSettings;
 
@@ -85,6 +85,8 @@ fn stability_small_run_is_finite_and_keeps_energy_within_2_percent() {
         seed: 3,
         restir: RestirSettings::default(),
         out_dir: Some(out.clone()),
+        sweep: SweepMode::All,
+        argv: vec![],
         device: DeviceArgs {
             device: None,
             validate: true,

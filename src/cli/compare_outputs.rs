@@ -1,0 +1,199 @@
+//! `compare`'s outputs: results.csv, the error-against-time charts, the equal-time strip and
+//! the equal-time lines, from the rows of one process or of merged jobs.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context as _, Result};
+use glam::Vec3;
+
+use super::compare::{CompareArgs, CompareRow, Setup};
+use super::method_spec::MethodSpec;
+use crate::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
+use crate::metrics::{rel_mse, rel_squared_error};
+use crate::render::Image;
+
+/// The inset window: the square (a quarter of the image's width) where `image` is furthest
+/// from the reference.
+fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> Inset {
+    let size = (width.min(height) / 4).max(4).min(width.min(height));
+    let error = |x: u32, y: u32| {
+        let i = (y * width + x) as usize;
+        rel_squared_error(image[i], reference[i])
+    };
+    let mut best = (f64::NEG_INFINITY, Inset { x: 0, y: 0, size });
+    let step = (size / 2).max(1);
+    for y in (0..=height - size).step_by(step as usize) {
+        for x in (0..=width - size).step_by(step as usize) {
+            let e: f64 = (y..y + size)
+                .flat_map(|yy| (x..x + size).map(move |xx| (xx, yy)))
+                .map(|(xx, yy)| error(xx, yy))
+                .filter(|e| e.is_finite())
+                .sum();
+            if e > best.0 {
+                best = (e, Inset { x, y, size });
+            }
+        }
+    }
+    best.1
+}
+
+pub(super) fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
+    let mut csv = String::from(
+        "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            csv,
+            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.6e},{:.5},{},{}",
+            r.method,
+            r.budget_ms,
+            r.knob,
+            r.gpu_ms_per_frame,
+            r.rel_mse,
+            r.rel_mse_trimmed,
+            r.mse,
+            r.energy_ratio,
+            r.failed_shift_rate.map(|f| format!("{f:.5}")).unwrap_or_default(),
+            r.nonfinite_pixels
+        );
+    }
+    std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// The equal-time lines, results.csv, the charts and the strip of a whole sweep; `device`
+/// names the device(s) in the charts' titles.
+pub(super) fn write_outputs(
+    args: &CompareArgs,
+    setup: &Setup,
+    budgets: &[f64],
+    rows: &[CompareRow],
+    images: &[(String, f64, Image)],
+    device: &str,
+) -> Result<()> {
+    for line in equal_time_lines(rows, budgets) {
+        println!("{line}");
+    }
+    write_csv(&args.out_dir.join("results.csv"), rows)?;
+    let motion = if args.camera_path { "a moving camera" } else { "a static camera" };
+    let title = format!(
+        "{} {}x{}, frame {} of {motion}, {device}",
+        setup.path.display(),
+        setup.width,
+        setup.height,
+        args.frames
+    );
+    for (metric, name, value) in [
+        ("rel_mse", "relMSE", (|r: &CompareRow| r.rel_mse) as fn(&CompareRow) -> f64),
+        ("mse", "MSE", |r| r.mse),
+    ] {
+        let series: Vec<Series> = setup
+            .methods
+            .iter()
+            .map(|m| Series {
+                name: m.label(),
+                points: rows
+                    .iter()
+                    .filter(|r| r.method == m.label())
+                    .map(|r| (r.gpu_ms_per_frame, value(r)))
+                    .collect(),
+            })
+            .collect();
+        write_line_chart(
+            &args.out_dir.join(format!("{metric}_vs_time")),
+            &LineChart {
+                title: &title,
+                x_label: "GPU ms per frame",
+                y_label: name,
+                log_x: true,
+                series: &series,
+            },
+        )?;
+    }
+    write_strip(
+        &args.out_dir.join("equal_time.png"),
+        budgets,
+        &setup.methods,
+        images,
+        &setup.reference,
+        setup.width,
+        setup.height,
+    )?;
+    eprintln!(
+        "wrote results.csv, rel_mse_vs_time.svg/png, mse_vs_time.svg/png and equal_time.png in {}",
+        args.out_dir.display()
+    );
+    Ok(())
+}
+
+/// A run whose frames took longer than this multiple of its budget is not an equal-time point:
+/// the cost model fits budgets from a few calibration frames, and a method whose cost grows
+/// faster than linearly with its knob can overshoot.
+const OVER_BUDGET_TOLERANCE: f64 = 1.2;
+
+/// For each budget where the path tracer and ReSTIR PT both ran within it: the path tracer's
+/// relMSE over the best ReSTIR PT method's, plain and trimmed, and a line for each run left out
+/// for overshooting its budget.
+pub fn equal_time_lines(rows: &[CompareRow], budgets: &[f64]) -> Vec<String> {
+    type Error = fn(&CompareRow) -> f64;
+    let mut lines = vec![];
+    for &budget in budgets {
+        let within = |r: &&CompareRow| r.gpu_ms_per_frame <= OVER_BUDGET_TOLERANCE * budget;
+        for r in rows.iter().filter(|r| r.budget_ms == budget && !within(r)) {
+            lines.push(format!(
+                "equal time {budget:.1} ms: {} left out, its frames took {:.1} ms",
+                r.method, r.gpu_ms_per_frame
+            ));
+        }
+        let lowest = |pt: bool, error: Error| {
+            rows.iter()
+                .filter(|r| r.budget_ms == budget && (r.method == "pt") == pt)
+                .filter(within)
+                .min_by(|a, b| error(a).total_cmp(&error(b)))
+        };
+        let plain: Error = |r| r.rel_mse;
+        let trimmed: Error = |r| r.rel_mse_trimmed;
+        for (name, error) in [("relMSE", plain), ("trimmed relMSE", trimmed)] {
+            if let (Some(pt), Some(best)) = (lowest(true, error), lowest(false, error)) {
+                lines.push(format!(
+                    "equal time {budget:.1} ms, {name}: pt {:.4e} ({:.1} ms) / {} {:.4e} ({:.1} ms) = {:.2}x",
+                    error(pt),
+                    pt.gpu_ms_per_frame,
+                    best.method,
+                    error(best),
+                    best.gpu_ms_per_frame,
+                    error(pt) / error(best)
+                ));
+            }
+        }
+    }
+    lines
+}
+
+/// The strip of the largest budget every method fit (or the largest budget run at all).
+fn write_strip(
+    path: &Path,
+    budgets: &[f64],
+    methods: &[MethodSpec],
+    images: &[(String, f64, Image)],
+    reference: &[Vec3],
+    width: u32,
+    height: u32,
+) -> Result<()> {
+    let complete = |b: f64| methods.iter().all(|m| images.iter().any(|(l, ib, _)| *l == m.label() && *ib == b));
+    let largest_complete = budgets.iter().copied().filter(|&b| complete(b)).reduce(f64::max);
+    let Some(budget) = largest_complete.or_else(|| images.iter().map(|i| i.1).reduce(f64::max)) else {
+        return Ok(());
+    };
+    let chosen: Vec<&(String, f64, Image)> = images.iter().filter(|i| i.1 == budget).collect();
+    let inset = worst_window(&chosen[0].2.mean, reference, width, height);
+    let mut panels = vec![StripPanel {
+        label: "reference".into(),
+        pixels: reference,
+    }];
+    panels.extend(chosen.iter().map(|(label, _, image)| StripPanel {
+        label: format!("{label} ({:.3} relMSE)", rel_mse(&image.mean, reference)),
+        pixels: &image.mean,
+    }));
+    write_image_strip(path, width, height, &panels, inset)
+}
