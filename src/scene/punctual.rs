@@ -1,4 +1,4 @@
-//! `KHR_lights_punctual`: point, spot and directional lights in world space, with the
+//! `KHR_lights_punctual`: point, spot and directional lights in scene coordinates, with the
 //! extension's units (point and spot intensity in candela, directional in lux).
 
 use anyhow::{bail, Result};
@@ -15,10 +15,11 @@ pub enum PunctualKind {
     Directional = 2,
 }
 
-/// A punctual light in scene coordinates (world space translated by `Scene::origin`). Radiometry: the renderer's radiance unit is the glTF
-/// emission unit (1 nit), so a point or spot light of `intensity` I (candela, times `color`)
-/// gives irradiance I·cosθ/d² at distance d, and a directional light of I (lux) gives
-/// irradiance I·cosθ everywhere (KHR_lights_punctual, "Units").
+/// A punctual light in scene coordinates (world space moved by -`Scene::origin`). Radiometry:
+/// the renderer's radiance unit is the glTF emission unit (1 nit), so a point or spot light of
+/// `intensity` I (candela, times `color`) gives irradiance I·cosθ/d² at distance d, and a
+/// directional light of I (lux) gives irradiance I·cosθ everywhere (KHR_lights_punctual,
+/// "Units").
 #[derive(Debug, Clone, PartialEq)]
 pub struct PunctualLight {
     pub kind: PunctualKind,
