@@ -1,9 +1,10 @@
 // Profile counters of a kernel compiled with TRAVERSAL_COUNTERS=1 (`restir-pt bench --counters`):
-// per invocation ("lane") how many traversals (one ray or one pair of rays), BVH node visits, triangle tests and path steps it ran,
-// and per subgroup (one llvmpipe SIMD group of lanes in lockstep) how many iterations the node,
-// triangle and path loops took, counted once by the elected lane. A lane idles in an iteration
-// its subgroup runs without it, so lane counts over (subgroup iterations * subgroup size) are
-// the share of SIMD lanes doing work. Twin of the host's TraversalCounters (src/render/counters.rs).
+// per invocation ("lane") how many traversals (one ray or one pair of rays), BVH node visits,
+// triangle tests and path steps it ran, and per subgroup (one llvmpipe SIMD group of lanes in
+// lockstep) how many iterations the node, triangle and path loops took, counted once by the
+// elected lane. A lane idles in an iteration its subgroup runs without it, so lane counts over
+// (subgroup iterations * subgroup size) are the share of SIMD lanes doing work. The host reads
+// them as TraversalCounters (src/render/counters.rs).
 #ifndef COUNTERS_GLSL
 #define COUNTERS_GLSL
 

@@ -11,6 +11,7 @@ use serde::Serialize;
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::metrics::median;
 use crate::render::{PathTracer, RenderSettings, TraversalCounters};
+use crate::scene::Scene;
 
 pub struct BenchArgs {
     pub scene: Option<PathBuf>,
@@ -118,38 +119,14 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     let runs = args.runs.max(1);
     let ctx = open_device(&args.device)?;
     let stage_device = lap.lap();
-    let never = AtomicBool::new(false);
-    let (mut rates, mut gpu_ms, mut cpu_rates) = (Vec::new(), Vec::new(), Vec::new());
-    let mut counters = args.counters.then(TraversalCounters::default);
-    let mut stage_warm_up = None;
-    // Run 0 warms up: llvmpipe compiles the pipeline at its first dispatch.
     let mut tracer = PathTracer::with_counters(&ctx, &scene, &settings, args.counters)?;
-    for run in 0..=runs {
-        tracer.restart(&scene, &RenderSettings { seed: run, ..settings.clone() })?;
-        let cpu0 = process_cpu_seconds();
-        let stats = tracer.render(&|_| {}, &never)?;
-        let cpu_s = process_cpu_seconds() - cpu0;
-        if run == 0 {
-            stage_warm_up = Some(lap.lap());
-            continue;
-        }
-        let rate = stats.paths_per_second(settings.pixel_count());
-        let paths = settings.pixel_count() as f64 * stats.spp as f64;
-        eprintln!(
-            "run {run}: {:.1} ms GPU, {:.1} ms wall, {:.1} ms CPU, {:.3} M paths/s, {:.3} M paths per CPU second",
-            stats.gpu_ms,
-            stats.wall_ms,
-            cpu_s * 1e3,
-            rate * 1e-6,
-            paths / cpu_s * 1e-6
-        );
-        rates.push(rate);
-        gpu_ms.push(stats.gpu_ms);
-        cpu_rates.push(paths / cpu_s);
-        if let (Some(total), Some(c)) = (counters.as_mut(), stats.counters) {
-            total.add(&c);
-        }
-    }
+    let Runs {
+        rates,
+        gpu_ms,
+        cpu_rates,
+        counters,
+        stage_warm_up,
+    } = timed_runs(&mut tracer, &scene, &settings, runs, &mut lap)?;
     let stage_timed_runs = lap.lap();
     drop(tracer);
     finish_device(&ctx)?;
@@ -170,7 +147,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         median_paths_per_cpu_second: median(&cpu_rates),
         stage_load,
         stage_device,
-        stage_warm_up: stage_warm_up.expect("run 0 is the warm-up"),
+        stage_warm_up,
         stage_timed_runs,
         whole_process: whole.lap(),
         counters,
@@ -180,6 +157,57 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         std::fs::write(r, serde_json::to_string_pretty(&report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
     }
     Ok(())
+}
+
+/// The figures of the timed renders.
+struct Runs {
+    rates: Vec<f64>,
+    gpu_ms: Vec<f64>,
+    cpu_rates: Vec<f64>,
+    counters: Option<TraversalCounters>,
+    stage_warm_up: StageTime,
+}
+
+/// One warm-up render (llvmpipe compiles the pipeline at its first dispatch), timed by `lap`,
+/// then `runs` timed renders with seeds 1..=runs.
+fn timed_runs(tracer: &mut PathTracer, scene: &Scene, settings: &RenderSettings, runs: u32, lap: &mut Stopwatch) -> Result<Runs> {
+    let never = AtomicBool::new(false);
+    let (mut rates, mut gpu_ms, mut cpu_rates) = (Vec::new(), Vec::new(), Vec::new());
+    let mut counters: Option<TraversalCounters> = None;
+    let mut stage_warm_up = None;
+    for run in 0..=runs {
+        tracer.restart(scene, &RenderSettings { seed: run, ..settings.clone() })?;
+        let cpu0 = process_cpu_seconds();
+        let stats = tracer.render(&|_| {}, &never)?;
+        let cpu_s = process_cpu_seconds() - cpu0;
+        if run == 0 {
+            stage_warm_up = Some(lap.lap());
+            continue;
+        }
+        let rate = stats.paths_per_second(settings.pixel_count());
+        let paths = settings.pixel_count() as f64 * stats.spp as f64;
+        eprintln!(
+            "run {run}: {:.1} ms GPU, {:.1} ms wall, {:.1} ms CPU, {:.3} M paths/s, {:.3} M paths per CPU second",
+            stats.gpu_ms,
+            stats.wall_ms,
+            cpu_s * 1e3,
+            rate * 1e-6,
+            paths / cpu_s * 1e-6
+        );
+        rates.push(rate);
+        gpu_ms.push(stats.gpu_ms);
+        cpu_rates.push(paths / cpu_s);
+        if let Some(c) = stats.counters {
+            counters.get_or_insert_with(TraversalCounters::default).add(&c);
+        }
+    }
+    Ok(Runs {
+        rates,
+        gpu_ms,
+        cpu_rates,
+        counters,
+        stage_warm_up: stage_warm_up.expect("run 0 is the warm-up"),
+    })
 }
 
 fn print_report(r: &BenchReport) {
