@@ -248,6 +248,9 @@ void path_begin(vec3 camera, Vertex x1, uint seed, bool nee_end, out Path path) 
 // traversal (see visibility_ray).
 bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
     path_begin(camera, x1, seed, nee_end, path);
+    // A path's rows in shared memory hold MAX_PATH_LENGTH vertices; writing past them would
+    // overwrite another invocation's path.
+    if (target_length > MAX_PATH_LENGTH) return false;
     vec3 prev_pos = camera;
     while (path.count < target_length) {
         loop_tick();

@@ -228,7 +228,9 @@ impl PathTracer {
             TARGET_SUBMISSION_MS_GPU
         };
         while self.samples_done < self.settings.spp {
-            if cancel.load(Ordering::Relaxed) {
+            // The first chunk always runs, so that an interrupted render's image has a sample
+            // in every pixel (a pixel of no samples would read 0/0).
+            if self.samples_done > 0 && cancel.load(Ordering::Relaxed) {
                 interrupted = true;
                 break;
             }
