@@ -27,7 +27,7 @@ use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DE
 use crate::bvh::{offset_ray_origin, segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::{
-    emitted_radiance, emitter_pdf, environment_pdf, is_punctual_light, punctual_arrival, punctual_occluded, punctual_pdf,
+    emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded, punctual_pdf,
     sample_light,
 };
 use crate::scene::PunctualKind;
@@ -232,7 +232,7 @@ fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
 /// Radiance emitted by the end vertex `end` towards `from`.
 fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     if end.is_escaped() {
-        return scene.environment;
+        return environment_radiance(scene, end.pos);
     }
     if end.is_punctual() {
         return punctual_arrival(&scene.lights[end.light() as usize], from.pos).2;
@@ -252,7 +252,7 @@ fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
     }
     let (dir, dist) = direction(scene, from, end);
     if end.is_escaped() {
-        environment_pdf(scene)
+        environment_pdf(scene, dir)
     } else {
         emitter_pdf(scene, end.triangle, dir, dist)
     }

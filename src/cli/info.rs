@@ -25,7 +25,10 @@ pub fn info(path: &Path, options: &LoadOptions) -> Result<()> {
         scene.emitters.len(),
         scene.emitter_power
     );
-    println!("environment: {:?}", scene.environment.to_array());
+    match &scene.environment_map {
+        Some(map) => println!("environment: {}x{} equirectangular map (importance-sampled by luminance)", map.width, map.height),
+        None => println!("environment: {:?}", scene.environment.to_array()),
+    }
     println!("bounds: {:?} .. {:?} (extent {:.4})", lo.to_array(), hi.to_array(), scene.extent());
     println!("punctual lights: {}", scene.lights.len());
     for (i, l) in scene.lights.iter().enumerate() {

@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3};
 
 use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
+use crate::environment::EnvironmentMap;
 use crate::gpu_types::{Material, Triangle};
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
@@ -60,6 +61,8 @@ pub struct LoadOptions {
     pub scene: Option<usize>,
     /// An environment that replaces the file's (and the default one).
     pub environment: Option<Vec3>,
+    /// An equirectangular environment map (.exr or .hdr) that replaces the file's environment.
+    pub environment_map: Option<PathBuf>,
     /// The device's per-binding limit (bytes): a file whose accessor counts promise more
     /// triangles than one binding holds fails before its vertices are read.
     pub max_binding_bytes: Option<u64>,
@@ -215,7 +218,8 @@ impl Loader<'_> {
             Some(env) => env,
             None => scene_environment(self.path, &scene)?,
         };
-        self.finish(environment)
+        let map = options.environment_map.as_deref().map(EnvironmentMap::load).transpose()?;
+        self.finish(environment, map)
     }
 
     fn walk_nodes(&mut self, scene: &gltf::Scene) -> Result<()> {
@@ -279,7 +283,7 @@ impl Loader<'_> {
         }
     }
 
-    fn finish(&mut self, environment: Vec3) -> Result<Scene> {
+    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>) -> Result<Scene> {
         let this = self;
         let skipped_bounds = this.counts.skipped_bounds;
         this.report_counts();
@@ -296,7 +300,7 @@ impl Loader<'_> {
             .iter()
             .any(|t| Vec3::from(this.materials[t.material as usize].emission).max_element() > 0.0);
         let mut environment = environment;
-        if !has_emitter && this.lights.is_empty() && environment.max_element() <= 0.0 {
+        if !has_emitter && this.lights.is_empty() && environment.max_element() <= 0.0 && map.is_none() {
             environment = DEFAULT_ENVIRONMENT;
             this.warn(format!(
                 "the scene has no light (no emissive triangle, punctual light or environment): using a uniform environment of radiance {}",
@@ -318,6 +322,7 @@ impl Loader<'_> {
             materials: std::mem::take(&mut this.materials),
             material_names: std::mem::take(&mut this.material_names),
             environment,
+            environment_map: map,
             cameras: std::mem::take(&mut this.cameras),
             lights: std::mem::take(&mut this.lights),
             warnings: Vec::new(),

@@ -335,3 +335,49 @@ fn real_scenes_binding_limit_is_checked_from_accessor_counts_before_loading() {
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("about 4194304 triangles") && stderr.contains("per binding"), "{stderr}");
 }
+
+#[test]
+fn real_scenes_env_file_loads_exr_and_hdr_and_renders_with_both_methods() {
+    let map = crate::sampling_statistics::test_environment_map();
+    let dir = crate::common::temp_file("placeholder", b"").parent().unwrap().join("env");
+    std::fs::create_dir_all(&dir).unwrap();
+    let exr = dir.join("sky.exr");
+    restir_pt::image_io::write_exr(&exr, map.width, map.height, &map.texels).unwrap();
+    let hdr = dir.join("sky.hdr");
+    let pixels: Vec<image::Rgb<f32>> = map.texels.iter().map(|t| image::Rgb(t.to_array())).collect();
+    image::codecs::hdr::HdrEncoder::new(std::fs::File::create(&hdr).unwrap())
+        .encode(&pixels, map.width as usize, map.height as usize)
+        .unwrap();
+    let scene = corpus("no-light.gltf");
+    for file in [&exr, &hdr] {
+        let options = LoadOptions {
+            environment_map: Some(file.clone()),
+            ..Default::default()
+        };
+        let mut warnings = Vec::new();
+        let loaded = load_scene_reporting(&scene, &options, &mut warnings).unwrap();
+        let m = loaded.environment_map.as_ref().unwrap();
+        assert_eq!((m.width, m.height), (24, 12));
+        // RGBE keeps 8 bits of mantissa per channel: 1% on the brightest channel.
+        for (a, b) in m.texels.iter().zip(&map.texels) {
+            assert!((*a - *b).abs().max_element() <= 0.01 * b.max_element() + 1e-6, "{}: {a} vs {b}", file.display());
+        }
+        assert!(!warnings.iter().any(|w| w.contains("no light")), "{warnings:?}");
+    }
+    let bad = dir.join("sky.png");
+    std::fs::write(&bad, b"x").unwrap();
+    let (code, _, stderr) = restir_pt(&["render", scene.to_str().unwrap(), "--env", bad.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("R,G,B") && stderr.contains("FILE.exr|FILE.hdr"), "{stderr}");
+    for method in [["--method", "pt", "--spp", "8"].as_slice(), &["--method", "restir"]] {
+        let out = dir.join("env-render.exr");
+        let mut args = vec!["render", scene.to_str().unwrap(), "--env", exr.to_str().unwrap(), "--width", "16", "--height", "16"];
+        args.extend_from_slice(method);
+        args.extend(["--out", out.to_str().unwrap()]);
+        let (code, _, stderr) = restir_pt(&args);
+        assert_eq!(code, 0, "{method:?}: {stderr}");
+        let (_, _, pixels) = restir_pt::image_io::read_exr(&out).unwrap();
+        assert!(pixels.iter().all(|p| p.is_finite()), "{method:?}: non-finite pixels");
+        assert!(pixels.iter().any(|p| p.max_element() > 0.0), "{method:?}: black image");
+    }
+}
