@@ -87,7 +87,11 @@ impl EnvironmentMap {
             let mut acc = 0.0f64;
             for &x in row {
                 acc += x;
-                texel_cdf.push(if row_sum > 0.0 { (acc / row_sum) as f32 } else { (texel_cdf.len() % w + 1) as f32 / w as f32 });
+                texel_cdf.push(if row_sum > 0.0 {
+                    (acc / row_sum) as f32
+                } else {
+                    (texel_cdf.len() % w + 1) as f32 / w as f32
+                });
             }
             // Rounding must not leave the last entry below 1: a u near 1 would find no texel.
             *texel_cdf.last_mut().expect("w > 0") = 1.0;

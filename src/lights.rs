@@ -63,7 +63,13 @@ pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, dir: Vec3, dist: f32) 
     if dist.is_infinite() {
         return trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
     }
-    trace_occluded(&scene.nodes, &scene.triangles, origin, x + dir * dist - origin, 1.0 - SEGMENT_EPSILON)
+    trace_occluded(
+        &scene.nodes,
+        &scene.triangles,
+        origin,
+        x + dir * dist - origin,
+        1.0 - SEGMENT_EPSILON,
+    )
 }
 
 /// The probability that NEE chooses punctual light `k` (a discrete probability, not a density).

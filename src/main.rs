@@ -4,8 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
 use glam::Vec3;
+use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
 use restir_pt::image_io::Exposure;
 use restir_pt::render::{RestirSettings, ReuseMis, ShiftKind};
 use restir_pt::scene::LoadOptions;
@@ -406,7 +406,11 @@ fn parse_env(s: &str) -> Result<EnvOpt, String> {
 
 fn parse_radiance(s: &str) -> Result<Vec3, String> {
     let usage = || format!("{s:?} must be R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr");
-    let values: Vec<f32> = s.split(',').map(|v| v.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| usage())?;
+    let values: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| usage())?;
     match values[..] {
         [r, g, b] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok(Vec3::new(r, g, b)),
         _ => Err(usage()),

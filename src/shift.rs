@@ -27,13 +27,13 @@ use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, lobe_weights, DELTA_ALPHA, LOBE_DE
 use crate::bvh::{offset_ray_origin, segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::{
-    emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded, punctual_pdf,
-    sample_light,
+    emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
+    punctual_pdf, sample_light,
 };
-use crate::scene::PunctualKind;
 use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
 use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::sampling::balance_heuristic;
+use crate::scene::PunctualKind;
 use crate::scene::Scene;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
@@ -87,7 +87,11 @@ impl Vertex {
     /// Punctual light `id` as a vertex: its position, or the direction towards a directional one.
     pub fn punctual(scene: &Scene, id: u32) -> Vertex {
         let l = &scene.lights[(id & !PUNCTUAL_LIGHT_BIT) as usize];
-        let pos = if l.kind == PunctualKind::Directional { -l.direction } else { l.position };
+        let pos = if l.kind == PunctualKind::Directional {
+            -l.direction
+        } else {
+            l.position
+        };
         Vertex {
             pos,
             normal: Vec3::ZERO,

@@ -18,7 +18,10 @@ pub fn info(path: &Path, options: &LoadOptions) -> Result<()> {
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());
-    println!("loaded in {load_ms:.0} ms, of which BVH build and emitter table {:.0} ms", scene.build_ms);
+    println!(
+        "loaded in {load_ms:.0} ms, of which BVH build and emitter table {:.0} ms",
+        scene.build_ms
+    );
     println!("BVH nodes: {}", scene.nodes.len());
     println!(
         "emitters: {} triangles, power {:.4} (luminance W)",
@@ -26,7 +29,10 @@ pub fn info(path: &Path, options: &LoadOptions) -> Result<()> {
         scene.emitter_power
     );
     match &scene.environment_map {
-        Some(map) => println!("environment: {}x{} equirectangular map (importance-sampled by luminance)", map.width, map.height),
+        Some(map) => println!(
+            "environment: {}x{} equirectangular map (importance-sampled by luminance)",
+            map.width, map.height
+        ),
         None => println!("environment: {:?}", scene.environment.to_array()),
     }
     println!("bounds: {:?} .. {:?} (extent {:.4})", lo.to_array(), hi.to_array(), scene.extent());
@@ -43,7 +49,13 @@ pub fn info(path: &Path, options: &LoadOptions) -> Result<()> {
     println!("materials: {}", scene.materials.len());
     let mut uses = vec![0usize; scene.materials.len()];
     scene.triangles.iter().for_each(|t| uses[t.material as usize] += 1);
-    for ((m, name), used) in scene.materials.iter().zip(&scene.material_names).zip(uses).take(MAX_LISTED_MATERIALS) {
+    for ((m, name), used) in scene
+        .materials
+        .iter()
+        .zip(&scene.material_names)
+        .zip(uses)
+        .take(MAX_LISTED_MATERIALS)
+    {
         println!(
             "  {name}: base {:?} metallic {} roughness {} transmission {} ior {} emission {:?}{} ({used} triangles)",
             m.base_color,

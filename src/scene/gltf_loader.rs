@@ -100,8 +100,7 @@ fn load_bytes_reporting(
     let raw = read_raw(bytes, path, &mut warn)?;
     check_external_buffers(&raw.json, base, path)?;
     let document = parse_gltf(raw.json, path)?;
-    let buffers = gltf::import_buffers(&document, base, raw.blob)
-        .map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
+    let buffers = gltf::import_buffers(&document, base, raw.blob).map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
     for (i, (data, buffer)) in buffers.iter().zip(document.buffers()).enumerate() {
         if data.len() < buffer.length() {
             bail!(problem(
@@ -203,7 +202,10 @@ impl Loader<'_> {
         let doc = self.doc;
         let scene = match options.scene {
             Some(i) => doc.scenes().nth(i).ok_or_else(|| {
-                problem(self.path, format!("--scene {i} does not exist; the file has {} scene(s)", doc.scenes().count()))
+                problem(
+                    self.path,
+                    format!("--scene {i} does not exist; the file has {} scene(s)", doc.scenes().count()),
+                )
             })?,
             None => doc
                 .default_scene()
@@ -357,8 +359,10 @@ impl Loader<'_> {
 pub const DEFAULT_ENVIRONMENT: Vec3 = Vec3::ONE;
 
 fn triangle_bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
-    triangles.iter().flat_map(Triangle::vertices).fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(p), hi.max(p)),
-    )
+    triangles
+        .iter()
+        .flat_map(Triangle::vertices)
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        })
 }

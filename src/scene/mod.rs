@@ -89,7 +89,11 @@ impl Scene {
         let triangle_power = powers.iter().fold(0.0, |a, p| a + p);
         // Punctual lights join the alias table after the triangles, chosen by power too.
         let bounds = (Vec3::from(bvh.nodes[0].lo), Vec3::from(bvh.nodes[0].hi));
-        let scene_radius = if triangles.is_empty() { 1.0 } else { 0.5 * (bounds.1 - bounds.0).length() };
+        let scene_radius = if triangles.is_empty() {
+            1.0
+        } else {
+            0.5 * (bounds.1 - bounds.0).length()
+        };
         for (k, light) in parts.lights.iter().enumerate() {
             emitter_tris.push(PUNCTUAL_LIGHT_BIT | k as u32);
             powers.push(light.power(scene_radius).max(f32::MIN_POSITIVE));
@@ -115,7 +119,11 @@ impl Scene {
             material_names: parts.material_names,
             emitters,
             emitter_power: triangle_power,
-            environment: if parts.environment_map.is_some() { Vec3::ZERO } else { parts.environment },
+            environment: if parts.environment_map.is_some() {
+                Vec3::ZERO
+            } else {
+                parts.environment
+            },
             environment_map: parts.environment_map,
             env_select_prob,
             cameras: parts.cameras,

@@ -60,7 +60,10 @@ impl Loader<'_> {
         if !colour.is_finite() || colour.min_element() < 0.0 || !intensity.is_finite() || intensity < 0.0 {
             bail!(problem(
                 self.path,
-                format!("light on node {}: color and intensity must be finite and non-negative", node.index())
+                format!(
+                    "light on node {}: color and intensity must be finite and non-negative",
+                    node.index()
+                )
             ));
         }
         if light.range().is_some() {
@@ -90,7 +93,10 @@ impl Loader<'_> {
         let direction = world.transform_vector3(-Vec3::Z).normalize();
         let position = world.transform_point3(Vec3::ZERO);
         if !direction.is_finite() {
-            bail!(problem(self.path, format!("light on node {} has a degenerate transform", node.index())));
+            bail!(problem(
+                self.path,
+                format!("light on node {} has a degenerate transform", node.index())
+            ));
         }
         if luminance(colour * intensity) > 0.0 {
             self.lights.push(PunctualLight {

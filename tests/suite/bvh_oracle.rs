@@ -275,7 +275,13 @@ fn environment_map_light_sampling_glsl_matches_rust() {
         ..Default::default()
     };
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-    let params = Buffer::new(&ctx, "params", std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64, BufferUsage::Uniform).unwrap();
+    let params = Buffer::new(
+        &ctx,
+        "params",
+        std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
+        BufferUsage::Uniform,
+    )
+    .unwrap();
     params.write(&[settings.frame_params(&scene)]).unwrap();
     let mut r = TestRng(6);
     let mut inputs = Vec::with_capacity(4 * RAYS);
@@ -304,7 +310,12 @@ fn environment_map_light_sampling_glsl_matches_rust() {
         let ls = sample_light(&scene, o, u);
         let g = &out[6 * i..6 * i + 6];
         assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light choice, item {i}");
-        assert!((g[2].truncate() - ls.dir).abs().max_element() < 1e-4, "sample_light direction, item {i}: {} vs {}", g[2].truncate(), ls.dir);
+        assert!(
+            (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
+            "sample_light direction, item {i}: {} vs {}",
+            g[2].truncate(),
+            ls.dir
+        );
         if ls.triangle == NO_EMITTER {
             env_samples += 1;
             // The map is piecewise constant: radiance and pdf must agree unless the direction
@@ -316,13 +327,25 @@ fn environment_map_light_sampling_glsl_matches_rust() {
                 near_edges += 1;
                 continue;
             }
-            assert_eq!(g[3].truncate(), environment_radiance(&scene, ls.dir), "environment radiance, item {i}");
-            assert!(close(g[3].w, environment_pdf(&scene, ls.dir), 1e-4), "environment pdf, item {i}: {} vs {}", g[3].w, ls.pdf);
+            assert_eq!(
+                g[3].truncate(),
+                environment_radiance(&scene, ls.dir),
+                "environment radiance, item {i}"
+            );
+            assert!(
+                close(g[3].w, environment_pdf(&scene, ls.dir), 1e-4),
+                "environment pdf, item {i}: {} vs {}",
+                g[3].w,
+                ls.pdf
+            );
         }
         assert!(close(g[3].w, ls.pdf, 1e-3), "sample_light pdf, item {i}");
     }
     assert!(env_samples > RAYS / 4, "only {env_samples} environment samples");
-    assert!(near_edges * 50 < env_samples, "{near_edges} of {env_samples} samples on texel edges");
+    assert!(
+        near_edges * 50 < env_samples,
+        "{near_edges} of {env_samples} samples on texel edges"
+    );
     drop(kernel);
     assert_clean(&ctx);
 }
