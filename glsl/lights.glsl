@@ -20,6 +20,14 @@
 #ifndef SCENE_PUNCTUAL
 #define SCENE_PUNCTUAL 1
 #endif
+// An equirectangular environment map (src/environment.rs) replaces the constant environment; its
+// rows start SCENE_ENV_MAP_BASE rows after the alias table in the emitter buffer.
+#ifndef SCENE_ENV_MAP
+#define SCENE_ENV_MAP 0
+#endif
+#ifndef SCENE_ENV_MAP_BASE
+#define SCENE_ENV_MAP_BASE 0u
+#endif
 
 struct LightSample {
     vec3 dir;        // unit direction from the shading point towards the light
@@ -117,7 +125,90 @@ float emitter_pdf(uint tri_index, vec3 dir, float dist) {
     return p_area * dist * dist / cos_l;
 }
 
-float environment_pdf() { return env_select_prob() * UNIFORM_SPHERE_PDF; }
+// u = 0.5 + atan2(d.x, -d.z) / 2pi (the centre column looks along -Z), v = acos(d.y) / pi (top +Y).
+vec2 equirect_uv(vec3 d) { return vec2(0.5 + atan(d.x, -d.z) / (2.0 * PI), acos(clamp(d.y, -1.0, 1.0)) / PI); }
+
+vec3 equirect_dir(vec2 uv) {
+    float phi = (uv.x - 0.5) * 2.0 * PI;
+    float theta = uv.y * PI;
+    float s = sin(theta);
+    return vec3(s * sin(phi), cos(theta), -s * cos(phi));
+}
+
+#if SCENE_ENV_MAP
+// Header (width, 0, 0, height), one row-CDF value per row, then per texel (r, g, b, row CDF).
+Emitter env_row(uint k) { return emitters[emitter_count + SCENE_ENV_MAP_BASE + k]; }
+uvec2 env_size() { Emitter h = env_row(0u); return uvec2(h.triangle, h.alias); }
+float env_cdf(uvec2 size, bool rows, uint i, uint j) {
+    return rows ? uintBitsToFloat(env_row(1u + j).triangle) : uintBitsToFloat(env_row(1u + size.y + i * size.x + j).alias);
+}
+
+// The first index j < n whose CDF value exceeds u (n - 1 if none): the rows' CDF, or row i's.
+// Sixteen fixed halving steps instead of a loop (n < 65536): llvmpipe budgets every loop's
+// iterations per invocation, and NEE runs this for every light sample.
+#define CDF_STEP(s) if (lo + s <= n && env_cdf(size, rows, i, lo + s - 1u) <= u) lo += s;
+uint cdf_search(uvec2 size, bool rows, uint i, uint n, float u) {
+    uint lo = 0u;
+    CDF_STEP(32768u) CDF_STEP(16384u) CDF_STEP(8192u) CDF_STEP(4096u) CDF_STEP(2048u) CDF_STEP(1024u)
+    CDF_STEP(512u) CDF_STEP(256u) CDF_STEP(128u) CDF_STEP(64u) CDF_STEP(32u) CDF_STEP(16u) CDF_STEP(8u)
+    CDF_STEP(4u) CDF_STEP(2u) CDF_STEP(1u)
+    return min(lo, n - 1u);
+}
+#undef CDF_STEP
+
+uvec2 env_texel_of(uvec2 size, vec2 uv) {
+    return uvec2(min(uint(uv.y * float(size.y)), size.y - 1u), min(uint(uv.x * float(size.x)), size.x - 1u));
+}
+
+// The probability of texel (i, j) from the CDFs that sampling inverts.
+float env_texel_probability(uvec2 size, uint i, uint j) {
+    float row = env_cdf(size, true, 0u, i) - (i > 0u ? env_cdf(size, true, 0u, i - 1u) : 0.0);
+    float texel = env_cdf(size, false, i, j) - (j > 0u ? env_cdf(size, false, i, j - 1u) : 0.0);
+    return row * texel;
+}
+#endif
+
+// Radiance arriving from direction dir (unit). Twin: lights::environment_radiance.
+vec3 environment_radiance(vec3 dir) {
+#if SCENE_ENV_MAP
+    uvec2 size = env_size();
+    uvec2 ij = env_texel_of(size, equirect_uv(dir));
+    Emitter t = env_row(1u + size.y + ij.x * size.x + ij.y);
+    return vec3(uintBitsToFloat(t.triangle), t.select_pdf, t.alias_prob);
+#else
+    return scene_env.rgb;
+#endif
+}
+
+// Solid-angle pdf that NEE samples the environment in direction dir (unit).
+float environment_pdf(vec3 dir) {
+#if SCENE_ENV_MAP
+    uvec2 size = env_size();
+    float sin_theta = length(dir.xz);  // not sqrt(1 - y^2): y rounds to +-1 near the poles
+    if (sin_theta <= 0.0) return 0.0;
+    uvec2 ij = env_texel_of(size, equirect_uv(dir));
+    float p_uv = env_texel_probability(size, ij.x, ij.y) * float(size.x * size.y);
+    return env_select_prob() * p_uv / (2.0 * PI * PI * sin_theta);
+#else
+    return env_select_prob() * UNIFORM_SPHERE_PDF;
+#endif
+}
+
+// A direction to the environment from u in [0, 1)^2 (by luminance for a map).
+vec3 sample_environment(vec2 u) {
+#if SCENE_ENV_MAP
+    uvec2 size = env_size();
+    uint i = cdf_search(size, true, 0u, size.y, u.x);
+    float below = i > 0u ? env_cdf(size, true, 0u, i - 1u) : 0.0;
+    float fu = clamp((u.x - below) / max(env_cdf(size, true, 0u, i) - below, 1.17549435e-38), 0.0, 0.9999999);
+    uint j = cdf_search(size, false, i, size.x, u.y);
+    float left = j > 0u ? env_cdf(size, false, i, j - 1u) : 0.0;
+    float fv = clamp((u.y - left) / max(env_cdf(size, false, i, j) - left, 1.17549435e-38), 0.0, 0.9999999);
+    return equirect_dir(vec2((float(j) + fv) / float(size.x), (float(i) + fu) / float(size.y)));
+#else
+    return sample_uniform_sphere(u);
+#endif
+}
 
 // Probability that NEE chooses punctual light k (discrete, not a density).
 float punctual_pdf(uint k) { return (1.0 - env_select_prob()) * punctual_light(k).select_pdf; }
@@ -132,10 +223,10 @@ LightSample sample_light(vec3 p, vec3 u) {
     ls.triangle = NO_EMITTER;
     float p_env = env_select_prob();
     if (SCENE_ENVIRONMENT != 0 && u.x < p_env) {
-        ls.dir = sample_uniform_sphere(u.yz);
+        ls.dir = sample_environment(u.yz);
         ls.dist = 1.0 / 0.0;
-        ls.radiance = scene_env.rgb;
-        ls.pdf = environment_pdf();
+        ls.radiance = environment_radiance(ls.dir);
+        ls.pdf = environment_pdf(ls.dir);
         return ls;
     }
     if (SCENE_EMITTERS == 0 || emitter_count == 0u) return ls;

@@ -77,9 +77,10 @@ bool path_step(inout PathState s) {
     if (!s.extend) return false;
     s.depth += 1u;
     if (hit.triangle == NO_HIT) {
-        if (SCENE_ENVIRONMENT != 0 && max_component(scene_env.rgb) > 0.0) {
-            float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, environment_pdf());
-            s.radiance += s.beta * scene_env.rgb * w;
+        vec3 le = SCENE_ENVIRONMENT != 0 ? environment_radiance(s.dir) : vec3(0.0);
+        if (max_component(le) > 0.0) {
+            float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, environment_pdf(s.dir));
+            s.radiance += s.beta * le * w;
         }
         return false;
     }

@@ -153,7 +153,7 @@ bool visible(Vertex from, Vertex to) {
 }
 
 vec3 end_emission(Vertex from, Vertex end) {
-    if (vertex_is_escaped(end)) return scene_env.rgb;
+    if (vertex_is_escaped(end)) return environment_radiance(end.pos);
     if (vertex_is_punctual(end)) {
         vec3 dir, value;
         float dist;
@@ -172,7 +172,7 @@ float light_pdf(Vertex from, Vertex end) {
     vec3 dir;
     float dist;
     direction(from, end, dir, dist);
-    return vertex_is_escaped(end) ? environment_pdf() : emitter_pdf(end.triangle, dir, dist);
+    return vertex_is_escaped(end) ? environment_pdf(dir) : emitter_pdf(end.triangle, dir, dist);
 }
 
 // Balance-heuristic weight of the technique that ended a path at `end` from `x` (reached from

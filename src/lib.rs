@@ -9,6 +9,7 @@ pub mod bundled_scenes;
 pub mod bvh;
 pub mod charts;
 pub mod cli;
+pub mod environment;
 pub mod error;
 pub mod gltf_writer;
 pub mod gpu_types;

@@ -63,7 +63,13 @@ pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, tri: u32, dir: Vec3, d
     if dist.is_infinite() {
         return trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
     }
-    trace_occluded(&scene.nodes, &scene.triangles, origin, x + dir * dist - origin, 1.0 - SEGMENT_EPSILON)
+    trace_occluded(
+        &scene.nodes,
+        &scene.triangles,
+        origin,
+        x + dir * dist - origin,
+        1.0 - SEGMENT_EPSILON,
+    )
 }
 
 /// The probability that NEE chooses punctual light `k` (a discrete probability, not a density).
@@ -141,8 +147,24 @@ pub fn emitter_pdf(scene: &Scene, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
     p_area * dist * dist / cos_l
 }
 
-pub fn environment_pdf(scene: &Scene) -> f32 {
-    scene.env_select_prob * UNIFORM_SPHERE_PDF
+/// Solid-angle pdf that NEE samples the environment in direction `dir` (unit): uniform over the
+/// sphere for a constant environment, the map's luminance density for a map. Twin of GLSL
+/// `environment_pdf`.
+pub fn environment_pdf(scene: &Scene, dir: Vec3) -> f32 {
+    scene.env_select_prob
+        * match &scene.environment_map {
+            Some(map) => map.pdf(dir),
+            None => UNIFORM_SPHERE_PDF,
+        }
+}
+
+/// Environment radiance arriving from direction `dir` (unit). Twin of GLSL
+/// `environment_radiance`.
+pub fn environment_radiance(scene: &Scene, dir: Vec3) -> Vec3 {
+    match &scene.environment_map {
+        Some(map) => map.radiance(dir),
+        None => scene.environment,
+    }
 }
 
 /// u.x selects the light, u.yz the point or direction.
@@ -156,11 +178,15 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
     };
     let p_env = scene.env_select_prob;
     if u.x < p_env {
+        let dir = match &scene.environment_map {
+            Some(map) => map.sample(Vec2::new(u.y, u.z)),
+            None => sample_uniform_sphere(Vec2::new(u.y, u.z)),
+        };
         return LightSample {
-            dir: sample_uniform_sphere(Vec2::new(u.y, u.z)),
+            dir,
             dist: f32::INFINITY,
-            radiance: scene.environment,
-            pdf: environment_pdf(scene),
+            radiance: environment_radiance(scene, dir),
+            pdf: environment_pdf(scene, dir),
             triangle: NO_EMITTER,
         };
     }

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
 use glam::Vec3;
+use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
 use restir_pt::image_io::Exposure;
 use restir_pt::render::{RestirSettings, ReuseMis, ShiftKind};
 use restir_pt::scene::LoadOptions;
@@ -187,9 +187,10 @@ struct RenderCmd {
     /// The glTF scene to render (index into the file's scenes; default: its default scene).
     #[arg(long = "scene")]
     scene_index: Option<usize>,
-    /// Environment radiance R,G,B replacing the scene's (and the default one).
-    #[arg(long, value_parser = parse_env)]
-    env: Option<Vec3>,
+    /// Environment replacing the scene's (and the default one): a radiance R,G,B, or an
+    /// equirectangular FILE.exr or FILE.hdr importance-sampled by luminance.
+    #[arg(long, value_parser = parse_env, value_name = "R,G,B|FILE")]
+    env: Option<EnvOpt>,
     /// PNG preview exposure: EV (radiance times 2^EV) or auto (log-average luminance to 0.18).
     /// The EXR is never changed.
     #[arg(long, default_value = "auto", value_parser = parse_exposure)]
@@ -457,11 +458,47 @@ fn parse_exposure(s: &str) -> Result<Exposure, String> {
     }
 }
 
-fn parse_env(s: &str) -> Result<Vec3, String> {
-    let values: Vec<f32> = s.split(',').map(|v| v.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("{s:?}: {e}"))?;
+/// `--env`: a constant radiance or an environment map file.
+#[derive(Clone, Debug)]
+enum EnvOpt {
+    Constant(Vec3),
+    File(PathBuf),
+}
+
+impl EnvOpt {
+    fn constant(&self) -> Option<Vec3> {
+        match self {
+            EnvOpt::Constant(c) => Some(*c),
+            EnvOpt::File(_) => None,
+        }
+    }
+
+    fn file(&self) -> Option<PathBuf> {
+        match self {
+            EnvOpt::File(f) => Some(f.clone()),
+            EnvOpt::Constant(_) => None,
+        }
+    }
+}
+
+fn parse_env(s: &str) -> Result<EnvOpt, String> {
+    let lower = s.to_ascii_lowercase();
+    if lower.ends_with(".exr") || lower.ends_with(".hdr") {
+        return Ok(EnvOpt::File(PathBuf::from(s)));
+    }
+    parse_radiance(s).map(EnvOpt::Constant)
+}
+
+fn parse_radiance(s: &str) -> Result<Vec3, String> {
+    let usage = || format!("{s:?} must be R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr");
+    let values: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| usage())?;
     match values[..] {
         [r, g, b] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok(Vec3::new(r, g, b)),
-        _ => Err(format!("{s:?} must be R,G,B: three finite, non-negative radiances")),
+        _ => Err(usage()),
     }
 }
 
@@ -497,7 +534,8 @@ fn main() -> ExitCode {
             allow_nonfinite: r.allow_nonfinite,
             load: LoadOptions {
                 scene: r.scene_index,
-                environment: r.env,
+                environment: r.env.as_ref().and_then(EnvOpt::constant),
+                environment_map: r.env.as_ref().and_then(EnvOpt::file),
                 max_binding_bytes: None,
             },
             exposure: r.exposure,

@@ -27,14 +27,14 @@ use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, DELTA
 use crate::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::{
-    emitted_radiance, emitter_pdf, environment_pdf, is_punctual_light, punctual_arrival, punctual_occluded, punctual_pdf,
-    sample_light,
+    emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
+    punctual_pdf, sample_light,
 };
-use crate::scene::PunctualKind;
 use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
 use crate::ray_offset::offset_ray_origin;
 use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::sampling::balance_heuristic;
+use crate::scene::PunctualKind;
 use crate::scene::Scene;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
@@ -88,7 +88,11 @@ impl Vertex {
     /// Punctual light `id` as a vertex: its position, or the direction towards a directional one.
     pub fn punctual(scene: &Scene, id: u32) -> Vertex {
         let l = &scene.lights[(id & !PUNCTUAL_LIGHT_BIT) as usize];
-        let pos = if l.kind == PunctualKind::Directional { -l.direction } else { l.position };
+        let pos = if l.kind == PunctualKind::Directional {
+            -l.direction
+        } else {
+            l.position
+        };
         Vertex {
             pos,
             normal: Vec3::ZERO,
@@ -244,7 +248,7 @@ fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
 /// Radiance emitted by the end vertex `end` towards `from`.
 fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     if end.is_escaped() {
-        return scene.environment;
+        return environment_radiance(scene, end.pos);
     }
     if end.is_punctual() {
         return punctual_arrival(&scene.lights[end.light() as usize], from.pos).2;
@@ -264,7 +268,7 @@ fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
     }
     let (dir, dist) = direction(scene, from, end);
     if end.is_escaped() {
-        environment_pdf(scene)
+        environment_pdf(scene, dir)
     } else {
         emitter_pdf(scene, end.triangle, dir, dist)
     }

@@ -113,13 +113,21 @@ fn punctual_lit() -> Value {
     let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
     let f = b.mesh("floor", &floor(), grey);
     b.instance("floor", f, 0.0, Vec3::ZERO);
-    b.punctual_light(json!({ "type": "point", "color": [1.0, 0.9, 0.8], "intensity": 3.0 }), Vec3::Y, -Vec3::Y);
+    b.punctual_light(
+        json!({ "type": "point", "color": [1.0, 0.9, 0.8], "intensity": 3.0 }),
+        Vec3::Y,
+        -Vec3::Y,
+    );
     b.punctual_light(
         json!({ "type": "spot", "intensity": 5.0, "spot": { "innerConeAngle": 0.3, "outerConeAngle": 0.6 } }),
         Vec3::new(0.5, 1.5, 0.5),
         -Vec3::Y,
     );
-    b.punctual_light(json!({ "type": "directional", "intensity": 0.5 }), Vec3::ZERO, Vec3::new(0.3, -1.0, 0.2));
+    b.punctual_light(
+        json!({ "type": "directional", "intensity": 0.5 }),
+        Vec3::ZERO,
+        Vec3::new(0.3, -1.0, 0.2),
+    );
     b.camera("camera", Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO, 0.8);
     serde_json::from_str(&b.finish("punctual", Vec3::ZERO)).expect("the builder writes JSON")
 }

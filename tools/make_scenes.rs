@@ -10,7 +10,10 @@ fn main() -> anyhow::Result<()> {
         anyhow::ensure!(flag == "--tiled-floor", "usage: make_scenes [--tiled-floor LEVELS OUT.gltf]");
         let levels: u32 = levels.parse()?;
         std::fs::write(out, restir_pt::bundled_scenes::tiled_floor(levels))?;
-        println!("wrote {out} ({} triangles)", (1usize << levels) * restir_pt::bundled_scenes::TILE_TRIANGLES);
+        println!(
+            "wrote {out} ({} triangles)",
+            (1usize << levels) * restir_pt::bundled_scenes::TILE_TRIANGLES
+        );
         return Ok(());
     }
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");

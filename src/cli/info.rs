@@ -60,14 +60,23 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene, load_ms: f64) {
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());
-    println!("loaded in {load_ms:.0} ms, of which BVH build and emitter table {:.0} ms", scene.build_ms);
+    println!(
+        "loaded in {load_ms:.0} ms, of which BVH build and emitter table {:.0} ms",
+        scene.build_ms
+    );
     println!("BVH nodes: {}", scene.nodes.len());
     println!(
         "emitters: {} triangles, power {:.4} (luminance W)",
         scene.emitters.len(),
         scene.emitter_power
     );
-    println!("environment: {:?}", scene.environment.to_array());
+    match &scene.environment_map {
+        Some(map) => println!(
+            "environment: {}x{} equirectangular map (importance-sampled by luminance)",
+            map.width, map.height
+        ),
+        None => println!("environment: {:?}", scene.environment.to_array()),
+    }
     println!(
         "bounds: {:?} .. {:?} (extent {:.4}), relative to the origin at {:?} (world; the first camera, else the centre of the bounds)",
         lo.to_array(),
@@ -88,7 +97,13 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene, load_ms: f64) {
     println!("materials: {}", scene.materials.len());
     let mut uses = vec![0usize; scene.materials.len()];
     scene.triangles.iter().for_each(|t| uses[t.material as usize] += 1);
-    for ((m, name), used) in scene.materials.iter().zip(&scene.material_names).zip(uses).take(MAX_LISTED_MATERIALS) {
+    for ((m, name), used) in scene
+        .materials
+        .iter()
+        .zip(&scene.material_names)
+        .zip(uses)
+        .take(MAX_LISTED_MATERIALS)
+    {
         println!(
             "  {name}: base {:?} metallic {} roughness {} transmission {} ior {} emission {:?}{} ({used} triangles)",
             m.base_color,

@@ -10,9 +10,8 @@ use serde::Serialize;
 
 use super::{finish_device, load_with_options, open_device, scene_path, DeviceArgs};
 use crate::image_io::{exposure_ev, write_exr, write_png_exposed, Exposure};
-use crate::scene::LoadOptions;
 use crate::render::{FrameStats, PathTracer, RenderSettings, Restir, RestirSettings, PASS_NAMES};
-use crate::scene::{camera_on_path, Scene};
+use crate::scene::{camera_on_path, LoadOptions, Scene};
 
 /// The rendering method: the path tracer, or ReSTIR PT with its settings.
 #[derive(Debug, Clone)]

@@ -26,7 +26,14 @@ impl SceneGpu {
     pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
         let source = scene.source.display();
         let upload = |name: &str, r: Result<Buffer, GpuError>| r.with_context(|| format!("{source}: uploading {name}"));
-        let emitter_rows: Vec<Emitter> = scene.emitters.iter().copied().chain(scene.punctual_rows()).collect();
+        let env_rows = scene.environment_map.as_ref().map(|m| m.gpu_rows()).unwrap_or_default();
+        let emitter_rows: Vec<Emitter> = scene
+            .emitters
+            .iter()
+            .copied()
+            .chain(scene.punctual_rows())
+            .chain(env_rows)
+            .collect();
         let arrays = [
             std::mem::size_of_val(scene.triangles.as_slice()),
             std::mem::size_of_val(scene.nodes.as_slice()),
@@ -43,12 +50,28 @@ impl SceneGpu {
             // and its BVH's one empty leaf never reads this placeholder.
             triangles: upload(
                 "triangles",
-                Buffer::from_slice(ctx, "triangles", if scene.triangles.is_empty() { &placeholder } else { &scene.triangles }),
+                Buffer::from_slice(
+                    ctx,
+                    "triangles",
+                    if scene.triangles.is_empty() {
+                        &placeholder
+                    } else {
+                        &scene.triangles
+                    },
+                ),
             )?,
             nodes: upload("BVH nodes", Buffer::from_slice(ctx, "BVH nodes", &scene.nodes))?,
             materials: upload(
                 "materials",
-                Buffer::from_slice(ctx, "materials", if scene.materials.is_empty() { &no_material } else { &scene.materials }),
+                Buffer::from_slice(
+                    ctx,
+                    "materials",
+                    if scene.materials.is_empty() {
+                        &no_material
+                    } else {
+                        &scene.materials
+                    },
+                ),
             )?,
             emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &emitter_rows))?,
             uniform,
@@ -85,6 +108,8 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
         ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),
+        ("SCENE_ENV_MAP", flag(scene.environment_map.is_some())),
+        ("SCENE_ENV_MAP_BASE", format!("{}u", PUNCTUAL_ROWS * scene.lights.len())),
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
     ];
     if uniform {
@@ -94,7 +119,14 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
             ("SCENE_MATERIAL_COUNT", scene.materials.len().max(1).to_string()),
             (
                 "SCENE_EMITTER_SLOTS",
-                (scene.emitters.len() + PUNCTUAL_ROWS * scene.lights.len()).max(1).to_string(),
+                (scene.emitters.len()
+                    + PUNCTUAL_ROWS * scene.lights.len()
+                    + scene
+                        .environment_map
+                        .as_ref()
+                        .map_or(0, |m| 1 + (m.height + m.width * m.height) as usize))
+                .max(1)
+                .to_string(),
             ),
         ]);
     }

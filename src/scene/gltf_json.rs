@@ -68,7 +68,10 @@ fn split_glb(bytes: &[u8], path: &Path) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
         Some(length) if (GLB_HEADER_BYTES..=bytes.len()).contains(&length) => {}
         Some(length) => bail!(problem(
             path,
-            format!("truncated or corrupt GLB: the header declares {length} bytes, the file has {}", bytes.len())
+            format!(
+                "truncated or corrupt GLB: the header declares {length} bytes, the file has {}",
+                bytes.len()
+            )
         )),
         None => bail!(problem(
             path,
@@ -127,7 +130,9 @@ fn strip_animation(json: &mut Value, warn: &mut dyn FnMut(String)) {
     if let Some(a) = root.remove("animations") {
         let n = a.as_array().map_or(0, Vec::len);
         if n > 0 {
-            warn(format!("{n} animation(s) ignored: the bind pose (node transforms as written) is rendered"));
+            warn(format!(
+                "{n} animation(s) ignored: the bind pose (node transforms as written) is rendered"
+            ));
         }
     }
     let mut skinned = 0;
@@ -139,19 +144,18 @@ fn strip_animation(json: &mut Value, warn: &mut dyn FnMut(String)) {
     if root.remove("skins").is_some() || skinned > 0 {
         warn(format!("skins ignored on {skinned} node(s): the bind pose is rendered"));
     }
-    let morphed = root
-        .get("meshes")
-        .and_then(Value::as_array)
-        .map_or(0, |meshes| {
-            meshes
-                .iter()
-                .filter_map(|m| m.get("primitives").and_then(Value::as_array))
-                .flatten()
-                .filter(|p| p.get("targets").is_some_and(|t| t.as_array().is_some_and(|t| !t.is_empty())))
-                .count()
-        });
+    let morphed = root.get("meshes").and_then(Value::as_array).map_or(0, |meshes| {
+        meshes
+            .iter()
+            .filter_map(|m| m.get("primitives").and_then(Value::as_array))
+            .flatten()
+            .filter(|p| p.get("targets").is_some_and(|t| t.as_array().is_some_and(|t| !t.is_empty())))
+            .count()
+    });
     if morphed > 0 {
-        warn(format!("morph targets of {morphed} primitive(s) ignored: the base shape is rendered"));
+        warn(format!(
+            "morph targets of {morphed} primitive(s) ignored: the base shape is rendered"
+        ));
     }
 }
 
@@ -183,7 +187,10 @@ fn percent_decode(uri: &str) -> String {
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
     while i < bytes.len() {
-        let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok()).and_then(|h| u8::from_str_radix(h, 16).ok());
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
         match (bytes[i], hex) {
             (b'%', Some(v)) => {
                 out.push(v);
@@ -211,7 +218,10 @@ pub(super) fn check_external_buffers(json: &Value, base: Option<&Path>, path: &P
             continue;
         }
         let Some(base) = base else {
-            bail!(problem(path, format!("buffer {i} refers to the external file {uri:?}, but the input has no folder")));
+            bail!(problem(
+                path,
+                format!("buffer {i} refers to the external file {uri:?}, but the input has no folder")
+            ));
         };
         let file = base.join(percent_decode(uri));
         if !file.is_file() {

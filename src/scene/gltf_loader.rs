@@ -9,6 +9,7 @@ use glam::{DMat4, DVec3, Vec3};
 
 use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
+use crate::environment::EnvironmentMap;
 use crate::gpu_types::{Material, Triangle};
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
@@ -67,6 +68,8 @@ pub struct LoadOptions {
     pub scene: Option<usize>,
     /// An environment that replaces the file's (and the default one).
     pub environment: Option<Vec3>,
+    /// An equirectangular environment map (.exr or .hdr) that replaces the file's environment.
+    pub environment_map: Option<PathBuf>,
     /// The device's per-binding limit (bytes): a file whose accessor counts promise more
     /// triangles than one binding holds fails before its vertices are read.
     pub max_binding_bytes: Option<u64>,
@@ -104,8 +107,7 @@ fn load_bytes_reporting(
     let raw = read_raw(bytes, path, &mut warn)?;
     check_external_buffers(&raw.json, base, path)?;
     let document = parse_gltf(raw.json, path)?;
-    let buffers = gltf::import_buffers(&document, base, raw.blob)
-        .map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
+    let buffers = gltf::import_buffers(&document, base, raw.blob).map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
     for (i, (data, buffer)) in buffers.iter().zip(document.buffers()).enumerate() {
         if data.len() < buffer.length() {
             bail!(problem(
@@ -212,7 +214,10 @@ impl<'a> Loader<'a> {
         let doc = self.doc;
         let scene = match options.scene {
             Some(i) => doc.scenes().nth(i).ok_or_else(|| {
-                problem(self.path, format!("--scene {i} does not exist; the file has {} scene(s)", doc.scenes().count()))
+                problem(
+                    self.path,
+                    format!("--scene {i} does not exist; the file has {} scene(s)", doc.scenes().count()),
+                )
             })?,
             None => doc
                 .default_scene()
@@ -228,7 +233,8 @@ impl<'a> Loader<'a> {
             Some(env) => env,
             None => scene_environment(self.path, &scene, doc)?,
         };
-        self.finish(environment)
+        let map = options.environment_map.as_deref().map(EnvironmentMap::load).transpose()?;
+        self.finish(environment, map)
     }
 
     /// Walks the hierarchy in f64 and re-centres the scene before rounding to f32: on its first
@@ -314,7 +320,7 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn finish(&mut self, environment: Vec3) -> Result<Scene> {
+    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>) -> Result<Scene> {
         let this = self;
         let skipped_bounds = this.counts.skipped_bounds;
         this.report_counts();
@@ -331,7 +337,7 @@ impl<'a> Loader<'a> {
             .iter()
             .any(|t| Vec3::from(this.materials[t.material as usize].emission).max_element() > 0.0);
         let mut environment = environment;
-        if !has_emitter && this.lights.is_empty() && environment.max_element() <= 0.0 {
+        if !has_emitter && this.lights.is_empty() && environment.max_element() <= 0.0 && map.is_none() {
             environment = DEFAULT_ENVIRONMENT;
             this.warn(format!(
                 "the scene has no light (no emissive triangle, punctual light or environment): using a uniform environment of radiance {}",
@@ -354,6 +360,7 @@ impl<'a> Loader<'a> {
             materials: std::mem::take(&mut this.materials),
             material_names: std::mem::take(&mut this.material_names),
             environment,
+            environment_map: map,
             cameras: std::mem::take(&mut this.cameras),
             lights: std::mem::take(&mut this.lights),
             warnings: Vec::new(),
@@ -390,8 +397,10 @@ impl<'a> Loader<'a> {
 pub const DEFAULT_ENVIRONMENT: Vec3 = Vec3::ONE;
 
 fn triangle_bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
-    triangles.iter().flat_map(Triangle::vertices).fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(p), hi.max(p)),
-    )
+    triangles
+        .iter()
+        .flat_map(Triangle::vertices)
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        })
 }

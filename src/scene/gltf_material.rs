@@ -111,15 +111,17 @@ impl Loader<'_> {
         );
         if let Some(sg) = m.pbr_specular_glossiness() {
             let diffuse = Vec3::from_slice(&sg.diffuse_factor()[..3]);
-            (base, metallic, roughness) =
-                spec_gloss_to_metal_rough(diffuse, Vec3::from(sg.specular_factor()), sg.glossiness_factor());
+            (base, metallic, roughness) = spec_gloss_to_metal_rough(diffuse, Vec3::from(sg.specular_factor()), sg.glossiness_factor());
         }
         let strength = m.emissive_strength().unwrap_or(1.0);
         let emissive = m.emissive_factor();
         let transmission = m.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0);
         let ior = m.ior().unwrap_or(1.5);
         let checks = [
-            ("baseColorFactor", base.is_finite() && base.min_element() >= 0.0 && base.max_element() <= 1.0),
+            (
+                "baseColorFactor",
+                base.is_finite() && base.min_element() >= 0.0 && base.max_element() <= 1.0,
+            ),
             ("metallicFactor", (0.0..=1.0).contains(&metallic)),
             ("roughnessFactor", (0.0..=1.0).contains(&roughness)),
             ("emissiveFactor", emissive.iter().all(|v| v.is_finite() && *v >= 0.0)),

@@ -29,9 +29,7 @@ pub fn triangle_indices(mode: gltf::mesh::Mode, indices: &[u32]) -> Option<Vec<[
                 [indices[i], indices[i + 1 + odd], indices[i + 2 - odd]]
             })
             .collect(),
-        Mode::TriangleFan => (1..n.saturating_sub(1))
-            .map(|i| [indices[i], indices[i + 1], indices[0]])
-            .collect(),
+        Mode::TriangleFan => (1..n.saturating_sub(1)).map(|i| [indices[i], indices[i + 1], indices[0]]).collect(),
         _ => return None,
     };
     let restart = !matches!(mode, Mode::Triangles);
@@ -54,7 +52,10 @@ impl Loader<'_> {
             let bad = || {
                 problem(
                     path,
-                    format!("node {}: EXT_mesh_gpu_instancing {what} must be a float {dims:?} accessor within its buffer", node.index()),
+                    format!(
+                        "node {}: EXT_mesh_gpu_instancing {what} must be a float {dims:?} accessor within its buffer",
+                        node.index()
+                    ),
                 )
             };
             let a = doc.accessors().nth(i).ok_or_else(bad)?;
@@ -87,7 +88,10 @@ impl Loader<'_> {
             })
             .collect();
         if transforms.iter().any(|m| !m.is_finite()) {
-            bail!(problem(path, format!("node {}: an EXT_mesh_gpu_instancing transform is not finite", node.index())));
+            bail!(problem(
+                path,
+                format!("node {}: an EXT_mesh_gpu_instancing transform is not finite", node.index())
+            ));
         }
         Ok(transforms)
     }
@@ -259,7 +263,10 @@ impl Loader<'_> {
             if !ok {
                 bail!(problem(
                     self.path,
-                    format!("mesh {}: COLOR_0 must be VEC3 or VEC4 of float, unsigned byte or unsigned short", mesh.index())
+                    format!(
+                        "mesh {}: COLOR_0 must be VEC3 or VEC4 of float, unsigned byte or unsigned short",
+                        mesh.index()
+                    )
                 ));
             }
         }

@@ -18,6 +18,7 @@ use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
 use crate::bvh::Bvh;
+use crate::environment::EnvironmentMap;
 use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::build_alias_table;
 
@@ -33,7 +34,10 @@ pub struct Scene {
     pub emitters: Vec<Emitter>,
     /// Total emitted power of the emissive triangles (W, luminance-weighted, front faces).
     pub emitter_power: f32,
+    /// Constant environment radiance (unused when `environment_map` is set).
     pub environment: Vec3,
+    /// An equirectangular environment map (`--env FILE`), replacing the constant.
+    pub environment_map: Option<EnvironmentMap>,
     pub env_select_prob: f32,
     pub cameras: Vec<Camera>,
     /// `KHR_lights_punctual` lights in scene coordinates (like the triangles: relative to
@@ -64,6 +68,7 @@ pub struct SceneParts {
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     pub environment: Vec3,
+    pub environment_map: Option<EnvironmentMap>,
     pub cameras: Vec<Camera>,
     pub lights: Vec<PunctualLight>,
     pub warnings: Vec<String>,
@@ -92,7 +97,11 @@ impl Scene {
         let triangle_power = powers.iter().fold(0.0, |a, p| a + p);
         // Punctual lights join the alias table after the triangles, chosen by power too.
         let bounds = (Vec3::from(bvh.nodes[0].lo), Vec3::from(bvh.nodes[0].hi));
-        let scene_radius = if triangles.is_empty() { 1.0 } else { 0.5 * (bounds.1 - bounds.0).length() };
+        let scene_radius = if triangles.is_empty() {
+            1.0
+        } else {
+            0.5 * (bounds.1 - bounds.0).length()
+        };
         for (k, light) in parts.lights.iter().enumerate() {
             emitter_tris.push(PUNCTUAL_LIGHT_BIT | k as u32);
             powers.push(light.power(scene_radius).max(f32::MIN_POSITIVE));
@@ -102,7 +111,7 @@ impl Scene {
         } else {
             build_alias_table(&emitter_tris, &powers)
         };
-        let has_env = luminance(parts.environment) > 0.0;
+        let has_env = luminance(parts.environment) > 0.0 || parts.environment_map.is_some();
         let env_select_prob = match (has_env, emitters.is_empty()) {
             (false, _) => 0.0,
             (true, true) => 1.0,
@@ -118,7 +127,12 @@ impl Scene {
             material_names: parts.material_names,
             emitters,
             emitter_power: triangle_power,
-            environment: parts.environment,
+            environment: if parts.environment_map.is_some() {
+                Vec3::ZERO
+            } else {
+                parts.environment
+            },
+            environment_map: parts.environment_map,
             env_select_prob,
             cameras: parts.cameras,
             lights: parts.lights,

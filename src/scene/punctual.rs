@@ -63,7 +63,10 @@ impl Loader<'_> {
         if !colour.is_finite() || colour.min_element() < 0.0 || !intensity.is_finite() || intensity < 0.0 {
             bail!(problem(
                 self.path,
-                format!("light on node {}: color and intensity must be finite and non-negative", node.index())
+                format!(
+                    "light on node {}: color and intensity must be finite and non-negative",
+                    node.index()
+                )
             ));
         }
         if light.range().is_some() {
@@ -92,7 +95,10 @@ impl Loader<'_> {
         };
         let direction = world.transform_vector3(-DVec3::Z).normalize().as_vec3();
         if !direction.is_finite() {
-            bail!(problem(self.path, format!("light on node {} has a degenerate transform", node.index())));
+            bail!(problem(
+                self.path,
+                format!("light on node {} has a degenerate transform", node.index())
+            ));
         }
         if luminance(colour * intensity) > 0.0 {
             self.light_positions.push(world.transform_point3(DVec3::ZERO));

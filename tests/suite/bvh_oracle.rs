@@ -1,7 +1,7 @@
 //! GLSL bvh.glsl, lights.glsl and camera.glsl against their Rust twins on a non-trivial scene:
 //! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use restir_pt::bvh::{trace_closest, trace_occluded, NO_HIT};
 use restir_pt::gltf_writer::MeshData;
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
@@ -54,6 +54,10 @@ fn random_scene_with_punctual_lights(seed: u64) -> Scene {
 }
 
 fn random_scene_lit(seed: u64, lights: Vec<PunctualLight>) -> Scene {
+    random_scene_full(seed, lights, None)
+}
+
+fn random_scene_full(seed: u64, lights: Vec<PunctualLight>, environment_map: Option<restir_pt::environment::EnvironmentMap>) -> Scene {
     let mut r = TestRng(seed);
     let mut triangles = Vec::new();
     for i in 0..6000 {
@@ -102,6 +106,7 @@ fn random_scene_lit(seed: u64, lights: Vec<PunctualLight>) -> Scene {
         materials,
         material_names: vec!["grey".into(), "light".into()],
         environment: Vec3::new(0.2, 0.3, 0.4),
+        environment_map,
         cameras: vec![Camera::look_at("test", Vec3::new(0.0, 1.0, 12.0), Vec3::ZERO, Vec3::Y, 0.8)],
         lights,
         warnings: vec![],
@@ -254,4 +259,94 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
         assert!(node.skip as usize <= scene.nodes.len());
     }
     assert!(seen.iter().all(|&c| c == 1), "a triangle is in no leaf or in two");
+}
+
+/// The environment half of light sampling with an equirectangular map (the scene's emitters beside
+/// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (lights.glsl, compiled
+/// with the scene's SCENE_ENV_MAP defines) against their Rust twins in src/lights.rs.
+#[test]
+fn environment_map_light_sampling_glsl_matches_rust() {
+    use restir_pt::lights::{environment_pdf, environment_radiance};
+    let ctx = gpu();
+    let scene = random_scene_full(5, vec![], Some(crate::sampling_statistics::test_environment_map()));
+    assert!(scene.env_select_prob > 0.0 && scene.env_select_prob < 1.0);
+    let settings = RenderSettings {
+        width: 64,
+        height: 48,
+        ..Default::default()
+    };
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    let params = Buffer::new(
+        &ctx,
+        "params",
+        std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
+        BufferUsage::Params,
+    )
+    .unwrap();
+    params.write(&[settings.frame_params(&scene)]).unwrap();
+    let mut r = TestRng(6);
+    let mut inputs = Vec::with_capacity(4 * RAYS);
+    for _ in 0..RAYS {
+        inputs.push((Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0).extend(1e30));
+        inputs.push(r.unit_vector().extend(0.0));
+        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
+        inputs.push(Vec4::ZERO);
+    }
+    let input = Buffer::from_slice(&ctx, "inputs", &inputs).unwrap();
+    let output = Buffer::new(&ctx, "outputs", (RAYS * 24 * 4) as u64, BufferUsage::Storage).unwrap();
+    output.fill(crate::common::NAN_FILL).unwrap();
+    let mut buffers = scene_gpu.buffers(&params);
+    buffers.extend([&input, &output]);
+    let mut kinds = scene_gpu.bindings();
+    kinds.extend([restir_pt::vk::Binding::Storage, restir_pt::vk::Binding::Storage]);
+    let defines = scene_gpu.defines();
+    assert!(defines.contains(&("SCENE_ENV_MAP", "1")));
+    let kernel = restir_pt::vk::Kernel::new(&ctx, "oracle/scene_oracle.comp", &defines, &kinds, 4).unwrap();
+    kernel.bind(&buffers);
+    kernel.run_1d(RAYS as u32, 64, bytemuck::bytes_of(&(RAYS as u32))).unwrap();
+    let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(RAYS * 24).unwrap()).to_vec();
+    let (mut env_samples, mut near_edges) = (0, 0);
+    for i in 0..RAYS {
+        let (o, u) = (inputs[4 * i].truncate(), inputs[4 * i + 2].truncate());
+        let ls = sample_light(&scene, o, u);
+        let g = &out[6 * i..6 * i + 6];
+        assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light choice, item {i}");
+        assert!(
+            (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
+            "sample_light direction, item {i}: {} vs {}",
+            g[2].truncate(),
+            ls.dir
+        );
+        if ls.triangle == NO_EMITTER {
+            env_samples += 1;
+            // The map is piecewise constant: radiance and pdf must agree unless the direction
+            // sits within 0.005 texels of a texel edge, where llvmpipe's atan/acos and Rust's
+            // may round to different texels.
+            let uv = restir_pt::environment::equirect_uv(ls.dir) * Vec2::new(24.0, 12.0);
+            let edge = (uv - uv.round()).abs().min_element() < 5e-3;
+            if edge {
+                near_edges += 1;
+                continue;
+            }
+            assert_eq!(
+                g[3].truncate(),
+                environment_radiance(&scene, ls.dir),
+                "environment radiance, item {i}"
+            );
+            assert!(
+                close(g[3].w, environment_pdf(&scene, ls.dir), 1e-4),
+                "environment pdf, item {i}: {} vs {}",
+                g[3].w,
+                ls.pdf
+            );
+        }
+        assert!(close(g[3].w, ls.pdf, 1e-3), "sample_light pdf, item {i}");
+    }
+    assert!(env_samples > RAYS / 4, "only {env_samples} environment samples");
+    assert!(
+        near_edges * 50 < env_samples,
+        "{near_edges} of {env_samples} samples on texel edges"
+    );
+    drop(kernel);
+    assert_clean(&ctx);
 }

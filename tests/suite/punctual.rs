@@ -99,7 +99,10 @@ fn compare(scene: &Scene, image: &Image, what: &str, pixel_tol: f32) -> (usize, 
     for y in 0..SIDE {
         for x in 0..SIDE {
             let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
-            if corners.iter().any(|&(dx, dy)| plane_hit(scene, x as f32 + dx, y as f32 + dy).is_none()) {
+            if corners
+                .iter()
+                .any(|&(dx, dy)| plane_hit(scene, x as f32 + dx, y as f32 + dy).is_none())
+            {
                 continue;
             }
             let (expected, range) = pixel_mean(scene, x, y);
@@ -121,7 +124,10 @@ fn compare(scene: &Scene, image: &Image, what: &str, pixel_tol: f32) -> (usize, 
     }
     assert!(n > 150, "{what}: only {n} pixels compared");
     let sum_err = (sum_got / sum_expected - 1.0).abs() as f32;
-    assert!(sum_err < 0.01, "{what}: the compared pixels sum to {sum_got}, the closed form to {sum_expected}");
+    assert!(
+        sum_err < 0.01,
+        "{what}: the compared pixels sum to {sum_got}, the closed form to {sum_expected}"
+    );
     (n, worst, sum_err)
 }
 
@@ -164,7 +170,11 @@ fn punctual_point_spot_and_directional_lights_match_the_closed_form_irradiance()
     for (name, light, position) in cases {
         let scene = plane_scene(name, light, position, Vec3::new(0.3, -1.0, 0.2));
         let (n, worst, sum) = compare(&scene, &path_traced(&scene, 1024), name, 0.01);
-        eprintln!("{name}, path tracer: {n} pixels, worst {:.3}%, sum {:.3}%", 100.0 * worst, 100.0 * sum);
+        eprintln!(
+            "{name}, path tracer: {n} pixels, worst {:.3}%, sum {:.3}%",
+            100.0 * worst,
+            100.0 * sum
+        );
     }
 }
 
@@ -200,7 +210,10 @@ fn punctual_point_light_restir_matches_the_closed_form_irradiance() {
             100.0 * worst,
             100.0 * sum
         );
-        assert!(attempted > 0 && failed < attempted, "{shift:?}: reuse onto the point light never succeeded");
+        assert!(
+            attempted > 0 && failed < attempted,
+            "{shift:?}: reuse onto the point light never succeeded"
+        );
     }
     assert_clean(&ctx);
 }

@@ -136,23 +136,36 @@ fn real_scenes_default_camera_frames_every_vertex() {
     let scene = load_scene(&corpus("no-camera.gltf")).unwrap();
     assert_eq!(scene.cameras.len(), 1);
     let c = &scene.cameras[0];
-    assert!(scene.warnings.iter().any(|w| w.contains("no perspective camera: using a default one")));
+    assert!(scene
+        .warnings
+        .iter()
+        .any(|w| w.contains("no perspective camera: using a default one")));
     assert!((c.forward - -restir_pt::scene::DEFAULT_VIEW_DIRECTION).length() < 1e-6);
     let tan_half = (0.5 * c.yfov).tan();
     for v in scene.triangles.iter().flat_map(|t| t.vertices()) {
         let d = v - c.position;
         let z = d.dot(c.forward);
         assert!(z > 0.0);
-        assert!(d.dot(c.right).abs() / z <= tan_half + 1e-5 && d.dot(c.up).abs() / z <= tan_half + 1e-5, "{v} is outside the view");
+        assert!(
+            d.dot(c.right).abs() / z <= tan_half + 1e-5 && d.dot(c.up).abs() / z <= tan_half + 1e-5,
+            "{v} is outside the view"
+        );
     }
 }
 
 #[test]
 fn real_scenes_warnings_survive_a_failed_load_and_identical_ones_collapse() {
     let mut warnings = Vec::new();
-    let e = load_scene_reporting(&corpus("warnings-then-error.gltf"), &LoadOptions::default(), &mut warnings).err().unwrap();
+    let e = load_scene_reporting(&corpus("warnings-then-error.gltf"), &LoadOptions::default(), &mut warnings)
+        .err()
+        .unwrap();
     assert!(format!("{e:#}").contains("does not fit its buffer"));
-    assert!(warnings.iter().any(|w| w.contains("warnings-then-error.gltf") && w.contains("animation(s) ignored")), "{warnings:?}");
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("warnings-then-error.gltf") && w.contains("animation(s) ignored")),
+        "{warnings:?}"
+    );
     let lines = ["a".to_string(), "b".to_string(), "a".to_string(), "a".to_string()];
     assert_eq!(collapse_warnings(&lines), vec!["a (x3)".to_string(), "b".to_string()]);
 }
@@ -172,12 +185,27 @@ fn real_scenes_scene_option_picks_a_scene() {
         ..Default::default()
     };
     assert_eq!(load_scene_reporting(&path, &options, &mut w).unwrap().triangles.len(), 1);
-    let e = load_scene_reporting(&path, &LoadOptions { scene: Some(7), ..Default::default() }, &mut w).err().unwrap();
-    assert!(format!("{e:#}").contains("--scene 7 does not exist; the file has 2 scene(s)"), "{e:#}");
+    let e = load_scene_reporting(
+        &path,
+        &LoadOptions {
+            scene: Some(7),
+            ..Default::default()
+        },
+        &mut w,
+    )
+    .err()
+    .unwrap();
+    assert!(
+        format!("{e:#}").contains("--scene 7 does not exist; the file has 2 scene(s)"),
+        "{e:#}"
+    );
 }
 
 fn restir_pt(args: &[&str]) -> (i32, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restir-pt")).args(args).output().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restir-pt"))
+        .args(args)
+        .output()
+        .unwrap();
     let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
     (out.status.code().unwrap_or(-1), text(&out.stdout), text(&out.stderr))
 }
@@ -188,7 +216,12 @@ fn real_scenes_cli_prints_warnings_before_a_load_error_and_info_describes_defaul
     let (code, _, stderr) = restir_pt(&["info", path.to_str().unwrap()]);
     assert_eq!(code, 1);
     let lines: Vec<&str> = stderr.lines().collect();
-    assert!(lines.iter().any(|l| l.starts_with("warning:") && l.contains("animation(s) ignored")), "{stderr}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("warning:") && l.contains("animation(s) ignored")),
+        "{stderr}"
+    );
     assert_eq!(lines.iter().filter(|l| l.starts_with("error:")).count(), 1, "{stderr}");
     let path = corpus("no-camera.gltf");
     let (code, stdout, stderr) = restir_pt(&["info", path.to_str().unwrap()]);
@@ -236,14 +269,28 @@ fn real_scenes_cli_width_alone_follows_the_aspect_ratio_and_exposure_is_printed(
     let dir = crate::common::temp_file("placeholder", b"").parent().unwrap().join("aspect");
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("cameras.exr");
-    let args = ["render", path.to_str().unwrap(), "--method", "pt", "--spp", "2", "--width", "24", "--out", out.to_str().unwrap()];
+    let args = [
+        "render",
+        path.to_str().unwrap(),
+        "--method",
+        "pt",
+        "--spp",
+        "2",
+        "--width",
+        "24",
+        "--out",
+        out.to_str().unwrap(),
+    ];
     let (code, _, stderr) = restir_pt(&args);
     assert_eq!(code, 0, "{stderr}");
     // The file's camera has aspectRatio 1: 24 x 24.
     let (w, h, pixels) = restir_pt::image_io::read_exr(&out).unwrap();
     assert_eq!((w, h), (24, 24));
     assert!(pixels.iter().all(|p| p.is_finite()));
-    assert!(stderr.contains("PNG preview: exposure") && stderr.contains("(automatic"), "{stderr}");
+    assert!(
+        stderr.contains("PNG preview: exposure") && stderr.contains("(automatic"),
+        "{stderr}"
+    );
 }
 
 /// Every .gltf under ../shared/assets (public sample files, unmodified), sorted; none if the
@@ -275,12 +322,25 @@ fn render_asset(file: &std::path::Path, method: &[&str]) {
     let dir = crate::common::temp_file("placeholder", b"").parent().unwrap().join("assets");
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("asset.exr");
-    let mut args = vec!["render", file.to_str().unwrap(), "--width", "16", "--height", "16", "--out", out.to_str().unwrap()];
+    let mut args = vec![
+        "render",
+        file.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        out.to_str().unwrap(),
+    ];
     args.extend_from_slice(method);
     let (code, _, stderr) = restir_pt(&args);
     assert_eq!(code, 0, "{} {method:?}: {stderr}", file.display());
     let (_, _, pixels) = restir_pt::image_io::read_exr(&out).unwrap();
-    assert!(pixels.iter().all(|p| p.is_finite()), "{} {method:?}: non-finite pixels", file.display());
+    assert!(
+        pixels.iter().all(|p| p.is_finite()),
+        "{} {method:?}: non-finite pixels",
+        file.display()
+    );
     let mean = pixels.iter().map(|p| p.element_sum()).sum::<f32>() / (3 * pixels.len()) as f32;
     assert!(mean > 1e-3, "{} {method:?}: black image (mean {mean})", file.display());
     eprintln!("{} {method:?}: mean {mean:.4}", file.display());
@@ -331,10 +391,86 @@ fn real_scenes_binding_limit_is_checked_from_accessor_counts_before_loading() {
         ..Default::default()
     };
     let e = format!("{:#}", load_scene_reporting(&path, &too_small, &mut Vec::new()).err().unwrap());
-    assert!(e.contains("floor3.gltf") && e.contains("about 16384 triangles") && e.contains("maxStorageBufferRange"), "{e}");
+    assert!(
+        e.contains("floor3.gltf") && e.contains("about 16384 triangles") && e.contains("maxStorageBufferRange"),
+        "{e}"
+    );
     // 4.2 M triangles, past lavapipe's 128 MiB per binding: refused from the counts, at once.
     let big = crate::common::temp_file("floor11.gltf", tiled_floor(11).as_bytes());
-    let (code, _, stderr) = restir_pt(&["render", big.to_str().unwrap(), "--method", "pt", "--spp", "1", "--width", "8", "--height", "8"]);
+    let (code, _, stderr) = restir_pt(&[
+        "render",
+        big.to_str().unwrap(),
+        "--method",
+        "pt",
+        "--spp",
+        "1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+    ]);
     assert_eq!(code, 1, "{stderr}");
-    assert!(stderr.contains("about 4194304 triangles") && stderr.contains("per binding"), "{stderr}");
+    assert!(
+        stderr.contains("about 4194304 triangles") && stderr.contains("per binding"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn real_scenes_env_file_loads_exr_and_hdr_and_renders_with_both_methods() {
+    let map = crate::sampling_statistics::test_environment_map();
+    let dir = crate::common::temp_file("placeholder", b"").parent().unwrap().join("env");
+    std::fs::create_dir_all(&dir).unwrap();
+    let exr = dir.join("sky.exr");
+    restir_pt::image_io::write_exr(&exr, map.width, map.height, &map.texels).unwrap();
+    let hdr = dir.join("sky.hdr");
+    let pixels: Vec<image::Rgb<f32>> = map.texels.iter().map(|t| image::Rgb(t.to_array())).collect();
+    image::codecs::hdr::HdrEncoder::new(std::fs::File::create(&hdr).unwrap())
+        .encode(&pixels, map.width as usize, map.height as usize)
+        .unwrap();
+    let scene = corpus("no-light.gltf");
+    for file in [&exr, &hdr] {
+        let options = LoadOptions {
+            environment_map: Some(file.clone()),
+            ..Default::default()
+        };
+        let mut warnings = Vec::new();
+        let loaded = load_scene_reporting(&scene, &options, &mut warnings).unwrap();
+        let m = loaded.environment_map.as_ref().unwrap();
+        assert_eq!((m.width, m.height), (24, 12));
+        // RGBE keeps 8 bits of mantissa per channel: 1% on the brightest channel.
+        for (a, b) in m.texels.iter().zip(&map.texels) {
+            assert!(
+                (*a - *b).abs().max_element() <= 0.01 * b.max_element() + 1e-6,
+                "{}: {a} vs {b}",
+                file.display()
+            );
+        }
+        assert!(!warnings.iter().any(|w| w.contains("no light")), "{warnings:?}");
+    }
+    let bad = dir.join("sky.png");
+    std::fs::write(&bad, b"x").unwrap();
+    let (code, _, stderr) = restir_pt(&["render", scene.to_str().unwrap(), "--env", bad.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("R,G,B") && stderr.contains("FILE.exr|FILE.hdr"), "{stderr}");
+    for method in [["--method", "pt", "--spp", "8"].as_slice(), &["--method", "restir"]] {
+        let out = dir.join("env-render.exr");
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--env",
+            exr.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ];
+        args.extend_from_slice(method);
+        args.extend(["--out", out.to_str().unwrap()]);
+        let (code, _, stderr) = restir_pt(&args);
+        assert_eq!(code, 0, "{method:?}: {stderr}");
+        let (_, _, pixels) = restir_pt::image_io::read_exr(&out).unwrap();
+        assert!(pixels.iter().all(|p| p.is_finite()), "{method:?}: non-finite pixels");
+        assert!(pixels.iter().any(|p| p.max_element() > 0.0), "{method:?}: black image");
+    }
 }

@@ -92,7 +92,10 @@ fn loader_gives_a_lightless_scene_the_default_environment_and_rejects_one_withou
     assert_eq!(scene.environment, Vec3::ONE);
     assert_eq!(scene.env_select_prob, 1.0);
     assert!(
-        scene.warnings.iter().any(|w| w.contains("dark.gltf") && w.contains("no light") && w.contains("radiance 1")),
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("dark.gltf") && w.contains("no light") && w.contains("radiance 1")),
         "{:?}",
         scene.warnings
     );
