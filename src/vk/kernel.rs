@@ -28,7 +28,7 @@ impl Binding {
 /// pipeline creation or at the first dispatch (llvmpipe JIT-compiles there), so both count.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct KernelCompile {
-    /// The GLSL file and its variant, e.g. "restir_temporal.comp (unmoved)".
+    /// The GLSL file and its variant, e.g. "restir_temporal.comp (unmoved camera)".
     pub name: String,
     /// Size of the SPIR-V module in bytes.
     pub spirv_bytes: usize,
@@ -84,7 +84,7 @@ impl Kernel {
         &self.compile
     }
 
-    /// Names the kernel's variant in its compile report, e.g. "(unmoved)".
+    /// Names the kernel's variant in its compile report, e.g. "(unmoved camera)".
     pub fn set_variant(&mut self, variant: &str) {
         self.compile.name = format!("{} {variant}", self.name);
     }
