@@ -11,6 +11,7 @@ use glam::Vec3;
 use super::compare_outputs::write_outputs;
 use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
 use super::sweep::SweepMode;
+use super::reference_record::check_reference;
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::image_io::read_exr;
 use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};
@@ -259,6 +260,13 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
             r.validate(settings.max_depth)?;
         }
     }
+    // The error is measured on the last frame, seen from this camera.
+    let last_camera = if args.camera_path {
+        camera_on_path(args.camera, args.frames - 1, scene.cameras.len())
+    } else {
+        args.camera
+    };
+    check_reference(&args.reference, &path, last_camera)?;
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     Ok(Setup {
         path,

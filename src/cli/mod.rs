@@ -8,6 +8,7 @@ mod info;
 mod method_spec;
 mod profile;
 mod reference;
+mod reference_record;
 mod render;
 mod shard;
 mod stability;

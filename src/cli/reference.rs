@@ -7,6 +7,7 @@ use anyhow::{bail, Result};
 use super::render::{interrupt_flag, progress_bar};
 use super::shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use super::reference_record::{scene_name, write_record, ReferenceRecord};
 use crate::image_io::write_exr;
 use crate::render::{PathTracer, RenderSettings};
 
@@ -92,6 +93,14 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
     } else {
         write_exr(&args.out, image.width, image.height, &image.mean)?;
         write_exr(&variance, image.width, image.height, &image.variance)?;
+        let record = ReferenceRecord {
+            scene: scene_name(&path),
+            camera: settings.camera,
+            width: image.width,
+            height: image.height,
+            spp: stats.spp,
+        };
+        write_record(&args.out, &record)?;
     }
     drop(tracer);
     finish_device(&ctx)?;

@@ -270,9 +270,10 @@ impl Outputs<'_> {
     }
 }
 
-fn frame_prefix(args: &RenderArgs, frame: u32) -> String {
+/// "frame F | camera C | " for runs of several frames (the camera a frame's reference needs).
+fn frame_prefix(args: &RenderArgs, frame: u32, cameras: usize) -> String {
     if args.frames > 1 {
-        format!("frame {frame} | ")
+        format!("frame {frame} | camera {} | ", frame_camera(args, frame, cameras))
     } else {
         String::new()
     }
@@ -324,7 +325,7 @@ fn render_path_traced(
             nonfinite_weights: stats.nonfinite_paths,
             restir: None,
         };
-        println!("{}{}", frame_prefix(args, frame), frame_report.summary_line());
+        println!("{}{}", frame_prefix(args, frame, scene.cameras.len()), frame_report.summary_line());
         guard_nonfinite(args, frame, &frame_report)?;
         outputs.write_frame(frame, &image)?;
         if stats.interrupted {
@@ -424,7 +425,7 @@ fn render_restir(
         };
         println!(
             "{}{} | {}",
-            frame_prefix(args, frame),
+            frame_prefix(args, frame, scene.cameras.len()),
             frame_report.summary_line(),
             detail.summary()
         );

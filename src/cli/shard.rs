@@ -267,6 +267,14 @@ pub fn merge(shards: &[PathBuf], out: &Path, allow_nonfinite: bool) -> Result<()
     let variance = variance_path(out);
     write_exr(out, image.width, image.height, &image.mean)?;
     write_exr(&variance, image.width, image.height, &image.variance)?;
+    let record = super::reference_record::ReferenceRecord {
+        scene: super::reference_record::scene_name(Path::new(&meta.scene)),
+        camera: meta.camera,
+        width: meta.width,
+        height: meta.height,
+        spp: meta.spp,
+    };
+    super::reference_record::write_record(out, &record)?;
     println!(
         "merged {} shards of {} | {}x{} | {} spp",
         shards.len(),

@@ -466,3 +466,43 @@ fn cli_render_reports_zero_nonfinite_counts_on_a_clean_scene() {
         (Some(0), Some(0))
     );
 }
+
+// `reference` records which camera its image shows, and `compare` refuses a reference of
+// another camera than the one its last frame sees, instead of measuring against it.
+#[test]
+fn cli_compare_refuses_a_reference_of_another_camera() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let reference = dir.join("ref0.exr");
+    let (code, _, stderr) = restir_pt(&[
+        "reference",
+        "scenes/cornell.gltf",
+        "--spp",
+        "2",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--camera",
+        "0",
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let record: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("ref0.json")).unwrap()).unwrap();
+    assert_eq!((record["camera"].as_u64(), record["scene"].as_str()), (Some(0), Some("cornell.gltf")));
+    let out = dir.join("cmp");
+    assert_clean_failure(
+        &[
+            "compare",
+            "scenes/cornell.gltf",
+            "--reference",
+            reference.to_str().unwrap(),
+            "--camera-path",
+            "--frames",
+            "3",
+            "--out-dir",
+            out.to_str().unwrap(),
+        ],
+        &["camera 0", "camera 2", "--camera 2"],
+    );
+}
