@@ -90,6 +90,8 @@ pub(super) struct Run<'a> {
     pub scene: &'a Scene,
     pub settings: &'a RenderSettings,
     pub camera_path: bool,
+    /// Samples per pixel of the reference, from its record.
+    pub reference_spp: Option<u32>,
     /// GPU ms of every frame rendered so far (calibration included), for the job's accounting.
     pub gpu_ms: Cell<f64>,
 }
@@ -213,6 +215,8 @@ pub(super) struct Setup {
     pub reference: Vec<Vec3>,
     pub methods: Vec<MethodSpec>,
     pub settings: RenderSettings,
+    /// Samples per pixel of the reference, from its record.
+    pub reference_spp: Option<u32>,
 }
 
 impl Setup {
@@ -221,6 +225,7 @@ impl Setup {
             scene: &self.scene,
             settings: &self.settings,
             camera_path,
+            reference_spp: self.reference_spp,
             gpu_ms: Cell::new(0.0),
         }
     }
@@ -266,7 +271,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     } else {
         args.camera
     };
-    check_reference(&args.reference, &path, last_camera)?;
+    let reference_spp = check_reference(&args.reference, &path, last_camera)?.map(|r| r.spp);
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     Ok(Setup {
         path,
@@ -276,6 +281,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
         reference,
         methods,
         settings,
+        reference_spp,
     })
 }
 
@@ -351,6 +357,20 @@ fn compare_all(args: &CompareArgs, setup: &Setup) -> Result<Vec<CompareRow>> {
     Ok(rows)
 }
 
+/// A reference needs several times the samples of the frames measured against it, or its own
+/// noise becomes a large part of their measured error.
+const REFERENCE_SPP_FACTOR: u32 = 4;
+
+fn warn_noisy_reference(renderer: &MethodRenderer, knob: u32, reference_spp: Option<u32>, label: &str, budget: f64) {
+    if let (MethodRenderer::PathTracing(..), Some(reference)) = (renderer, reference_spp) {
+        if knob.saturating_mul(REFERENCE_SPP_FACTOR) > reference {
+            eprintln!(
+                "warning: {label} at {budget:.1} ms renders {knob} spp per frame against a reference of {reference} spp: the reference's own noise is a large part of the measured error (render it with at least {REFERENCE_SPP_FACTOR}x the spp)"
+            );
+        }
+    }
+}
+
 /// One method at one budget: fits its knob, runs the trials and prints the row. None if even
 /// the method's cheapest frame does not fit. The image is the last trial's last frame.
 pub(super) fn measure(
@@ -367,6 +387,7 @@ pub(super) fn measure(
         return Ok(None);
     };
     let knob = run.fit_to_budget(renderer, knob, budget, args.frames)?;
+    warn_noisy_reference(renderer, knob, run.reference_spp, label, budget);
     let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
     let mut last = None;
     for t in 0..args.trials {

@@ -50,7 +50,8 @@ pub fn read_record(reference: &Path) -> Result<Option<ReferenceRecord>> {
 }
 
 /// Fails unless `reference` shows `scene` from `camera`; warns when it carries no record.
-pub fn check_reference(reference: &Path, scene: &Path, camera: usize) -> Result<()> {
+/// Returns the record, if any.
+pub fn check_reference(reference: &Path, scene: &Path, camera: usize) -> Result<Option<ReferenceRecord>> {
     let Some(record) = read_record(reference)? else {
         eprintln!(
             "warning: {}: no {} record says which camera it shows; make sure it is camera {camera} of {}",
@@ -58,7 +59,7 @@ pub fn check_reference(reference: &Path, scene: &Path, camera: usize) -> Result<
             record_path(reference).display(),
             scene.display()
         );
-        return Ok(());
+        return Ok(None);
     };
     if record.scene != scene_name(scene) || record.camera != camera {
         bail!(
@@ -70,7 +71,7 @@ pub fn check_reference(reference: &Path, scene: &Path, camera: usize) -> Result<
             scene.display()
         );
     }
-    Ok(())
+    Ok(Some(record))
 }
 
 #[cfg(test)]

@@ -505,4 +505,21 @@ fn cli_compare_refuses_a_reference_of_another_camera() {
         ],
         &["camera 0", "camera 2", "--camera 2"],
     );
+    // The static camera 0 matches; the path tracer's frames outnumber the reference's 2 spp.
+    let (code, _, stderr) = restir_pt(&[
+        "compare",
+        "scenes/cornell.gltf",
+        "--reference",
+        reference.to_str().unwrap(),
+        "--methods",
+        "pt",
+        "--budgets-ms",
+        "50",
+        "--frames",
+        "1",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("against a reference of 2 spp"), "{stderr}");
 }
