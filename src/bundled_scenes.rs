@@ -364,7 +364,12 @@ pub fn cornell_sphere(rings: u32, segments: u32) -> String {
     cornell_room(&mut b, CORNELL_LIGHT, CORNELL_LIGHT_SIZE);
     let white = b.material("box white", MaterialSpec::diffuse(WHITE));
     cornell_boxes(&mut b, white, white);
-    add(&mut b, "sphere", &MeshData::sphere(Vec3::new(0.0, 0.3, 0.25), 0.3, rings, segments), white);
+    add(
+        &mut b,
+        "sphere",
+        &MeshData::sphere(Vec3::new(0.0, 0.3, 0.25), 0.3, rings, segments),
+        white,
+    );
     cornell_camera_path(&mut b);
     b.finish("cornell-sphere", Vec3::ZERO)
 }

@@ -316,7 +316,11 @@ pub fn trace_pair(nodes: &[BvhNode], triangles: &[Triangle], brute_force: bool, 
         let tri = &triangles[i];
         if enter_c {
             if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, hit.t) {
-                *hit = Hit { t, triangle: i as u32, bary };
+                *hit = Hit {
+                    t,
+                    triangle: i as u32,
+                    bary,
+                };
             }
         }
         *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some();

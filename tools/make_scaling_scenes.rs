@@ -5,7 +5,10 @@
 use std::path::PathBuf;
 
 fn main() -> anyhow::Result<()> {
-    let dir = std::env::args().nth(1).map(PathBuf::from).unwrap_or_else(|| PathBuf::from("out/scaling"));
+    let dir = std::env::args()
+        .nth(1)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("out/scaling"));
     std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
     for (name, rings, segments) in [("1e2", 5, 8), ("1e4", 50, 100), ("1e6", 500, 1000)] {
         let path = dir.join(format!("cornell-sphere-{name}.gltf"));

@@ -176,7 +176,13 @@ fn timed_runs(tracer: &mut PathTracer, scene: &Scene, settings: &RenderSettings,
     let mut counters: Option<TraversalCounters> = None;
     let mut stage_warm_up = None;
     for run in 0..=runs {
-        tracer.restart(scene, &RenderSettings { seed: run, ..settings.clone() })?;
+        tracer.restart(
+            scene,
+            &RenderSettings {
+                seed: run,
+                ..settings.clone()
+            },
+        )?;
         let cpu0 = process_cpu_seconds();
         let stats = tracer.render(&|_| {}, &never)?;
         let cpu_s = process_cpu_seconds() - cpu0;

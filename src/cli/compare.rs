@@ -10,8 +10,8 @@ use glam::Vec3;
 
 use super::compare_outputs::write_outputs;
 use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
-use super::sweep::SweepMode;
 use super::reference_record::check_reference;
+use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
 use crate::image_io::read_exr;
 use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};

@@ -23,8 +23,8 @@ pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, Method, RenderArgs};
 pub use shard::{merge, merge_shards, read_shard, ShardMeta, ShardSpec, ShardSums};
-pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
 pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
+pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

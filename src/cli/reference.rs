@@ -4,10 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
+use super::reference_record::{scene_name, write_record, ReferenceRecord};
 use super::render::{interrupt_flag, progress_bar};
 use super::shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
 use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
-use super::reference_record::{scene_name, write_record, ReferenceRecord};
 use crate::image_io::write_exr;
 use crate::render::{PathTracer, RenderSettings};
 

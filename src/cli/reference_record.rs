@@ -27,10 +27,7 @@ pub fn record_path(reference: &Path) -> PathBuf {
 
 /// The file name of a scene path, as records store it.
 pub fn scene_name(scene: &Path) -> String {
-    scene
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default()
+    scene.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 pub fn write_record(reference: &Path, record: &ReferenceRecord) -> Result<()> {

@@ -161,7 +161,10 @@ mod tests {
             for rounds in 0..=3 {
                 for unmoved in [false, true] {
                     let plan = plan_frame(&state(Some(history), unmoved, rounds));
-                    assert!(plan.passes.iter().all(|p| p.slots.out_slot != history && p.slots.prev_slot == history));
+                    assert!(plan
+                        .passes
+                        .iter()
+                        .all(|p| p.slots.out_slot != history && p.slots.prev_slot == history));
                     assert_ne!(plan.final_slot, history);
                     assert_eq!(plan.passes.len(), 3 + rounds as usize);
                     assert!(plan.passes.len() <= RESTIR_MAX_PASSES);
@@ -206,6 +209,9 @@ mod tests {
         assert_eq!(plan.passes.len(), RESTIR_MAX_PASSES);
         assert_eq!(&table[..], &plan.passes.iter().map(|p| p.slots).collect::<Vec<_>>()[..]);
         let short = plan_frame(&state(None, false, 0));
-        assert_eq!(pass_table(&short)[short.passes.len()..], [RestirPass::default(); RESTIR_MAX_PASSES - 2]);
+        assert_eq!(
+            pass_table(&short)[short.passes.len()..],
+            [RestirPass::default(); RESTIR_MAX_PASSES - 2]
+        );
     }
 }

@@ -1,7 +1,7 @@
 //! Rendering on the GPU: scene upload, settings, the path tracer, ReSTIR PT and their images.
 
-mod frame_plan;
 mod counters;
+mod frame_plan;
 mod image;
 mod path_tracer;
 mod reservoir_layers;
@@ -10,8 +10,8 @@ mod restir_settings;
 mod scene_gpu;
 mod settings;
 
-pub use frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PlannedPass, PASS_NAMES};
 pub use counters::TraversalCounters;
+pub use frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PlannedPass, PASS_NAMES};
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir};

@@ -174,7 +174,9 @@ impl Restir {
         self.reuse.write(std::slice::from_ref(&ReuseParams::default()))?;
         for kernel in &mut self.kernels {
             progress(&kernel.compile_report().name);
-            kernel.warm_up(&0u32.to_ne_bytes()).with_context(|| format!("compiling {}", kernel.name))?;
+            kernel
+                .warm_up(&0u32.to_ne_bytes())
+                .with_context(|| format!("compiling {}", kernel.name))?;
         }
         Ok(())
     }
@@ -324,7 +326,11 @@ impl Restir {
                 self.timer.record_begin(cmd, slot as u32);
                 open = Some(slot);
             }
-            let layers = if pass.kernel == PassKernel::Shade { 1 } else { self.restir.reservoirs };
+            let layers = if pass.kernel == PassKernel::Shade {
+                1
+            } else {
+                self.restir.reservoirs
+            };
             let groups = [
                 self.settings.width.div_ceil(LOCAL_SIZE),
                 self.settings.height.div_ceil(LOCAL_SIZE),

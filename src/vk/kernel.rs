@@ -67,8 +67,8 @@ impl Kernel {
         let spirv = compile_kernel(name, defines)?;
         let glsl_ms = start.elapsed().as_secs_f64() * 1e3;
         let start = Instant::now();
-        let mut kernel = Self::from_spirv(ctx, name, &spirv, bindings, push_bytes)
-            .with_context(|| format!("creating the compute pipeline {name}"))?;
+        let mut kernel =
+            Self::from_spirv(ctx, name, &spirv, bindings, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
         kernel.compile = KernelCompile {
             name: name.to_string(),
             spirv_bytes: spirv.len() * 4,

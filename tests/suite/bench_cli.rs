@@ -9,7 +9,20 @@ use crate::common::temp_file;
 fn bench_report(scene: &str, name: &str) -> serde_json::Value {
     let report = temp_file(name, b"");
     let out = Command::new(env!("CARGO_BIN_EXE_restir-pt"))
-        .args(["bench", scene, "--width", "24", "--height", "16", "--spp", "3", "--runs", "2", "--counters", "--validate"])
+        .args([
+            "bench",
+            scene,
+            "--width",
+            "24",
+            "--height",
+            "16",
+            "--spp",
+            "3",
+            "--runs",
+            "2",
+            "--counters",
+            "--validate",
+        ])
         .arg("--report")
         .arg(&report)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -40,17 +53,26 @@ fn bench_reports_stages_cpu_time_and_traversal_counters() {
         let lanes = count(&r, "subgroup_size");
         let traversals = count(&r, "traversals");
         // Every step traces one pair; a path takes at least one step and at most max depth + 1.
-        assert!(traversals >= paths && traversals <= 9 * paths, "{traversals} traversals for {paths} paths");
+        assert!(
+            traversals >= paths && traversals <= 9 * paths,
+            "{traversals} traversals for {paths} paths"
+        );
         assert_eq!(count(&r, "path_steps"), traversals);
         let tests = count(&r, "triangle_tests");
-        assert!(tests <= count(&r, "triangle_iterations") * lanes, "more triangle tests than lanes ran");
+        assert!(
+            tests <= count(&r, "triangle_iterations") * lanes,
+            "more triangle tests than lanes ran"
+        );
         if brute_force {
             assert_eq!(tests, triangles * traversals, "brute force tests every triangle once per pair");
             assert_eq!(count(&r, "node_visits"), 0);
         } else {
             let visits = count(&r, "node_visits");
             assert!(visits >= traversals && visits <= count(&r, "node_iterations") * lanes);
-            assert!(tests > 0 && tests < triangles * traversals / 10, "{tests} tests: the BVH culls little");
+            assert!(
+                tests > 0 && tests < triangles * traversals / 10,
+                "{tests} tests: the BVH culls little"
+            );
         }
     }
 }

@@ -203,7 +203,8 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
         if restir_pt::lights::is_punctual_light(ls.triangle) {
             punctual_samples += 1;
-            let shadowed = restir_pt::lights::punctual_occluded(&scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+            let shadowed =
+                restir_pt::lights::punctual_occluded(&scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
             assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
             punctual_shadowed += shadowed as usize;
         }

@@ -172,7 +172,18 @@ fn cli_frames_render_along_the_camera_path() {
     assert_eq!(std::fs::read(dir.join("frame_0002.exr")).unwrap(), std::fs::read(&last).unwrap());
     // More frames than the scene has cameras walk its camera path back and forth.
     let (code, stdout, stderr) = restir_pt(&[
-        "render", "--frames", "16", "--width", "8", "--height", "8", "--method", "pt", "--spp", "1", "--out",
+        "render",
+        "--frames",
+        "16",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--method",
+        "pt",
+        "--spp",
+        "1",
+        "--out",
         last.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{stderr}");
@@ -489,7 +500,10 @@ fn cli_compare_refuses_a_reference_of_another_camera() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     let record: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("ref0.json")).unwrap()).unwrap();
-    assert_eq!((record["camera"].as_u64(), record["scene"].as_str()), (Some(0), Some("cornell.gltf")));
+    assert_eq!(
+        (record["camera"].as_u64(), record["scene"].as_str()),
+        (Some(0), Some("cornell.gltf"))
+    );
     let out = dir.join("cmp");
     assert_clean_failure(
         &[

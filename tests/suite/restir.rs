@@ -448,7 +448,10 @@ fn restir_compiles_every_kernel_at_start_up_and_none_in_frames() {
     let reports = renderer.compile_reports();
     assert_eq!(reports.len(), PassKernel::ALL.len());
     for k in &reports {
-        assert!(k.spirv_bytes > 0 && k.first_dispatch_ms > 0.0 && k.total_ms() >= k.first_dispatch_ms, "{k:?}");
+        assert!(
+            k.spirv_bytes > 0 && k.first_dispatch_ms > 0.0 && k.total_ms() >= k.first_dispatch_ms,
+            "{k:?}"
+        );
     }
     for camera in 0..4 {
         renderer.frame(&scene, camera, false).unwrap();

@@ -52,7 +52,14 @@ fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairR
     params.write(&[RenderSettings::default().frame_params(scene)]).unwrap();
     let inputs: Vec<Vec4> = pairs
         .iter()
-        .flat_map(|(c, s)| [c.origin.extend(c.tmax), c.dir.extend(0.0), s.origin.extend(s.tmax), s.dir.extend(0.0)])
+        .flat_map(|(c, s)| {
+            [
+                c.origin.extend(c.tmax),
+                c.dir.extend(0.0),
+                s.origin.extend(s.tmax),
+                s.dir.extend(0.0),
+            ]
+        })
         .collect();
     let input = Buffer::from_slice(ctx, "pairs", &inputs).unwrap();
     let output = Buffer::new(ctx, "hits", pairs.len() as u64 * 32, BufferUsage::Storage).unwrap();
@@ -104,7 +111,10 @@ fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
     let hits = assert_gpu_matches_twin(&big, &gpu_hits, &pairs, false);
     assert!(hits > PAIRS / 4, "only {hits} of {PAIRS} closest rays hit");
     let occluded = gpu_hits.iter().filter(|g| g.1).count();
-    assert!(occluded > PAIRS / 10 && occluded < PAIRS * 9 / 10, "{occluded} of {PAIRS} shadow rays occluded");
+    assert!(
+        occluded > PAIRS / 10 && occluded < PAIRS * 9 / 10,
+        "{occluded} of {PAIRS} shadow rays occluded"
+    );
 
     // The Cornell box is small enough for uniform buffers on lavapipe: both forms there.
     let cornell = load_scene(&restir_pt::cli::bundled_file("scenes/cornell.gltf".as_ref())).unwrap();
@@ -128,7 +138,11 @@ fn trace_pair_twin_equals_single_ray_traversals() {
             let (b, b_occluded) = trace_pair(&scene.nodes, &scene.triangles, true, c, s);
             if c.tmax > 0.0 {
                 let single = trace_closest(&scene.nodes, &scene.triangles, c.origin, c.dir, c.tmax);
-                assert_eq!((h.triangle, h.t.to_bits()), (single.triangle, single.t.to_bits()), "pair {i}: closest");
+                assert_eq!(
+                    (h.triangle, h.t.to_bits()),
+                    (single.triangle, single.t.to_bits()),
+                    "pair {i}: closest"
+                );
             } else {
                 assert_eq!(h.triangle, NO_HIT, "pair {i}: an inactive ray hit");
             }
