@@ -172,6 +172,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
     Resampler s = resampler_begin();
     PathRecord y = reservoir_empty().record;
     float W = 0.0;
+    float own_target = 0.0;
     float jacobian = 1.0;
     bool alive = false;
     for (uint step = 0u; step < n * n; ++step) {
@@ -184,6 +185,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
             // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
             Reservoir res = input_reservoir(i);
             W = res.W;
+            own_target = target_function(res.record.contribution);
             alive = W > 0.0;
             y = res.record;
             jacobian = 1.0;
@@ -203,7 +205,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
             float p0 = target_function(y.contribution);
             targets_from[0] = p0;
             // For input i itself the inverse shift returns its own sample, whose p̂ it carries.
-            if (i != 0u) targets_from[i] = target_function(input_reservoir(i).record.contribution) / jacobian;
+            if (i != 0u) targets_from[i] = own_target / jacobian;
         } else if (alive && wanted) {
             float t = target_function(y.contribution);
             if (shift) {
