@@ -1,5 +1,5 @@
 //! Generalized resampled importance sampling (GRIS) across domains with shift mappings: the
-//! estimator of ../shared/docs/math.md sections 2 to 4, written once over any sample type.
+//! estimator of docs/restir.md (generalized RIS), written once over any sample type.
 //! ReSTIR's reservoirs apply it per pixel; the tests check it on analytic domains.
 //!
 //! Inputs X_i come from their own domains with unbiased contribution weights W_{X_i}. Each is
