@@ -22,7 +22,7 @@ fn main() -> anyhow::Result<()> {
     }
     for (name, rings, segments) in scenes {
         let path = dir.join(format!("cornell-sphere-{name}.gltf"));
-        let gltf = restir_pt::bundled_scenes::cornell_sphere(rings, segments);
+        let gltf = restir_pt::scene::bundled_scenes::cornell_sphere(rings, segments);
         std::fs::write(&path, gltf).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
         println!("wrote {}", path.display());
     }
