@@ -61,7 +61,9 @@ impl SceneGpu {
         // Materials stay bound: a binding holds millions of them.
         let [tri_bytes, node_bytes, _, emitter_bytes] = arrays;
         let addressed = ctx.info.buffer_device_address
-            && [tri_bytes, node_bytes, emitter_bytes].iter().any(|&bytes| bytes as u64 > ctx.info.scene_binding_limit);
+            && [tri_bytes, node_bytes, emitter_bytes]
+                .iter()
+                .any(|&bytes| bytes as u64 > ctx.info.scene_binding_limit);
         // Divergent uniform-buffer indexing serialises on GPUs; on llvmpipe it beats storage loads.
         let uniform = !addressed
             && ctx.info.device_type == PhysicalDeviceType::CPU

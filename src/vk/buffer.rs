@@ -63,9 +63,7 @@ impl Buffer {
                 MemoryLocation::GpuToCpu,
             ),
             BufferUsage::Addressed => (
-                vk::BufferUsageFlags::STORAGE_BUFFER
-                    | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS
-                    | vk::BufferUsageFlags::TRANSFER_DST,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             ),
         };

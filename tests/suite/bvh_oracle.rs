@@ -158,7 +158,7 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(&scene)]).unwrap();
+    params.write(&[settings.frame_params(scene)]).unwrap();
 
     let mut r = TestRng(2);
     let mut inputs = Vec::with_capacity(4 * RAYS);
@@ -215,7 +215,7 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         for k in 0..3 {
             assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
         }
-        let ls = sample_light(&scene, o.truncate(), u);
+        let ls = sample_light(scene, o.truncate(), u);
         let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
         assert!(
             dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
@@ -231,7 +231,7 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
             punctual_samples += 1;
             let shadowed =
-                restir_pt::shading::lights::punctual_occluded(&scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+                restir_pt::shading::lights::punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
             assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
             punctual_shadowed += shadowed as usize;
         }
