@@ -6,10 +6,10 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 use ash::vk::PhysicalDeviceType;
 
-use crate::bsdf::lobe_weights;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
+use crate::shading::bsdf::lobe_weights;
 use crate::vk::{Binding, Buffer, Context};
 
 pub struct SceneGpu {
