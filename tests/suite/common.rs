@@ -38,6 +38,19 @@ pub fn run_oracle<T: bytemuck::Pod>(
     output_words: usize,
     count: u32,
 ) -> Vec<T> {
+    run_oracle_defined(ctx, kernel, &[], leading, inputs, output_words, count)
+}
+
+/// `run_oracle` of the kernel compiled with `defines` (name, value).
+pub fn run_oracle_defined<T: bytemuck::Pod>(
+    ctx: &Arc<Context>,
+    kernel: &str,
+    defines: &[(&str, &str)],
+    leading: &[&Buffer],
+    inputs: &[&[u8]],
+    output_words: usize,
+    count: u32,
+) -> Vec<T> {
     let input_buffers: Vec<Buffer> = inputs
         .iter()
         .enumerate()
@@ -49,7 +62,7 @@ pub fn run_oracle<T: bytemuck::Pod>(
     bindings.extend(input_buffers.iter());
     bindings.push(&output);
     let kinds = vec![Binding::Storage; bindings.len()];
-    let k = Kernel::new(ctx, kernel, &[], &kinds, 4).unwrap();
+    let k = Kernel::new(ctx, kernel, defines, &kinds, 4).unwrap();
     k.bind(&bindings);
     k.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
     let words = output.read::<u32>(output_words).unwrap();
