@@ -139,13 +139,12 @@ fn check_mis_weight(mis: Mis) {
                 confidence: case.confidences[i] as f64,
             })
             .collect();
-        for i in 0..case.n {
+        for (i, &gpu_weight) in gpu_weights.iter().enumerate().take(case.n) {
             let rust = mis_weight(&Recorded(case), &inputs, mis, i, i) as f32;
             assert!(
-                close(gpu_weights[i], rust, 1e-5),
-                "case {k} (n = {}) input {i} {mis:?}: GLSL mis_weight {} vs Rust gris::mis_weight {rust}",
-                case.n,
-                gpu_weights[i]
+                close(gpu_weight, rust, 1e-5),
+                "case {k} (n = {}) input {i} {mis:?}: GLSL mis_weight {gpu_weight} vs Rust gris::mis_weight {rust}",
+                case.n
             );
             positive += (rust > 0.0) as usize;
         }
@@ -179,7 +178,8 @@ fn gris_resampler_glsl_matches_rust() {
         let mut tie = false;
         for (i, o) in case.offers.iter().enumerate().take(case.n) {
             s.confidence += case.confidences[i];
-            if !(o.weight > 0.0) {
+            // The recorded weights are finite: zero stands for a failed shift.
+            if o.weight <= 0.0 {
                 continue;
             }
             let sum = s.weight_sum + o.weight;
