@@ -9,20 +9,12 @@
 #include "camera.glsl"
 #include "shift.glsl"
 
-#define SHIFT_RECONNECTION 0
-#define SHIFT_REPLAY 1
-#define SHIFT_HYBRID 2
-#define MIS_GBH 0
-#define MIS_PAIRWISE 1
 #ifndef SHIFT_MODE
 #define SHIFT_MODE SHIFT_HYBRID
 #endif
 #ifndef MIS_MODE
 #define MIS_MODE MIS_GBH
 #endif
-
-// Canonical input plus up to 8 neighbours.
-const uint MAX_INPUTS = 9u;
 
 // The domain of a reservoir: one pixel's paths seen from one frame's camera, the sub-pixel
 // position included. A path carries its own position (the camera stream of its seed), so a

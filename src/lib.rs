@@ -23,5 +23,6 @@ pub mod render;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
+pub mod shader_interface;
 pub mod shift;
 pub mod vk;

@@ -10,7 +10,8 @@ use crate::bsdf::lobe_weights;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
-use crate::vk::{Binding, Buffer, Context};
+use crate::shader_interface::SceneBinding;
+use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, Context};
 
 pub struct SceneGpu {
     pub triangles: Buffer,
@@ -79,15 +80,26 @@ impl SceneGpu {
         })
     }
 
-    /// The buffers for bindings 0-4, the frame parameters first.
-    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<&'a Buffer> {
-        vec![params, &self.triangles, &self.nodes, &self.materials, &self.emitters]
+    /// The buffers of bindings 0-4, with `params` as the frame parameters.
+    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<BoundBuffer<'a>> {
+        let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
+        vec![
+            SceneBinding::FrameParams.to(params),
+            SceneBinding::Triangles.slot(scene).to(&self.triangles),
+            SceneBinding::Nodes.slot(scene).to(&self.nodes),
+            SceneBinding::Materials.slot(scene).to(&self.materials),
+            SceneBinding::Emitters.slot(scene).to(&self.emitters),
+        ]
     }
 
-    /// The descriptor kinds of bindings 0-4.
-    pub fn bindings(&self) -> Vec<Binding> {
+    /// The layout of bindings 0-4: the frame parameters in a storage buffer, the scene arrays
+    /// in uniform or storage buffers (`uniform`).
+    pub fn bindings(&self) -> Vec<BindingSlot> {
         let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
-        vec![Binding::Storage, scene, scene, scene, scene]
+        SceneBinding::ALL
+            .iter()
+            .map(|&b| b.slot(if b == SceneBinding::FrameParams { Binding::Storage } else { scene }))
+            .collect()
     }
 
     /// The `#define`s every scene kernel is compiled with.

@@ -9,7 +9,7 @@ use restir_pt::lights::sample_light;
 use restir_pt::ray_offset::offset_ray_origin;
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
-use restir_pt::vk::{Buffer, BufferUsage};
+use restir_pt::vk::{BindingSlot, Buffer, BufferUsage};
 
 use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
 
@@ -148,8 +148,8 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
     let out: Vec<Vec4> = run_oracle(
         &ctx,
         "oracle/scene_oracle.comp",
-        &scene_gpu.buffers(&params),
-        &[bytemuck::cast_slice(&inputs)],
+        &crate::common::as_storage(scene_gpu.buffers(&params)),
+        &[("Inputs", bytemuck::cast_slice(&inputs))],
         RAYS * 24,
         RAYS as u32,
     );
@@ -297,13 +297,15 @@ fn environment_map_light_sampling_glsl_matches_rust() {
     let output = Buffer::new(&ctx, "outputs", (RAYS * 24 * 4) as u64, BufferUsage::Storage).unwrap();
     output.fill(crate::common::NAN_FILL).unwrap();
     let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend([&input, &output]);
-    let mut kinds = scene_gpu.bindings();
-    kinds.extend([restir_pt::vk::Binding::Storage, restir_pt::vk::Binding::Storage]);
+    buffers.extend([
+        BindingSlot::storage(5, "Inputs").to(&input),
+        BindingSlot::storage(6, "Outputs").to(&output),
+    ]);
+    let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
     let defines = scene_gpu.defines();
     assert!(defines.contains(&("SCENE_ENV_MAP", "1")));
-    let kernel = restir_pt::vk::Kernel::new(&ctx, "oracle/scene_oracle.comp", &defines, &kinds, 4).unwrap();
-    kernel.bind(&buffers);
+    let kernel = restir_pt::vk::Kernel::new(&ctx, "oracle/scene_oracle.comp", &defines, &layout, 4).unwrap();
+    kernel.bind(&buffers).unwrap();
     kernel.run_1d(RAYS as u32, 64, bytemuck::bytes_of(&(RAYS as u32))).unwrap();
     let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(RAYS * 24).unwrap()).to_vec();
     let (mut env_samples, mut near_edges) = (0, 0);

@@ -392,11 +392,11 @@ fn check_glsl_matches_rust(kind: Kind) {
         let out: Vec<Vec4> = crate::common::run_oracle(
             &ctx,
             "oracle/shift_oracle.comp",
-            &scene_gpu.buffers(&frame),
+            &crate::common::as_storage(scene_gpu.buffers(&frame)),
             &[
-                bytemuck::cast_slice(&shift_params),
-                bytemuck::cast_slice(&records),
-                bytemuck::cast_slice(&targets),
+                ("Params", bytemuck::cast_slice(&shift_params)),
+                ("Records", bytemuck::cast_slice(&records)),
+                ("Targets", bytemuck::cast_slice(&targets)),
             ],
             cases.len() * 13 * 4,
             cases.len() as u32,
