@@ -201,7 +201,7 @@ fn build_header() -> String {
         ("MAX_INPUTS", MAX_INPUTS),
         ("IMAGE_LOCAL_SIZE", IMAGE_LOCAL_SIZE),
         ("COUNTER_COUNT", COUNTER_COUNT as u32),
-        ("MAX_PATH_LENGTH", crate::path_record::MAX_PATH_LENGTH as u32),
+        ("MAX_PATH_LENGTH", crate::shading::path_record::MAX_PATH_LENGTH as u32),
         ("PUNCTUAL_ROWS", crate::gpu_types::PUNCTUAL_ROWS as u32),
     ];
     h.push('\n');

@@ -1,6 +1,7 @@
 //! The commands behind the CLI; main.rs only parses arguments into these structs.
 
 mod bench;
+pub mod charts;
 mod compare;
 mod compare_outputs;
 mod compare_sweep;
@@ -80,6 +81,7 @@ pub fn open_device(args: &DeviceArgs) -> Result<Arc<Context>> {
     let ctx = Context::new(&ContextOptions {
         device: args.device.clone(),
         validation: args.validate,
+        ..Default::default()
     })?;
     eprintln!("device: {} ({:?})", ctx.info.name, ctx.info.device_type);
     Ok(Arc::new(ctx))

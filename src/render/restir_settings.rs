@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Result};
 
-use crate::path_record::MAX_PATH_LENGTH;
+use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// The shift mapping used for reuse (and, inverted, for its MIS weights). The discriminant is
 /// the value of the kernels' SHIFT_MODE (src/shader_interface.rs writes the GLSL names).

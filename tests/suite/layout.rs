@@ -9,9 +9,9 @@ use std::collections::HashMap;
 use restir_pt::gpu_types::{
     BvhNode, Emitter, FrameParams, Material, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface, Triangle,
 };
-use restir_pt::path_record::PathRecord;
 use restir_pt::render::{PassKernel, ReuseMis, ShiftKind};
 use restir_pt::shader_interface::{PathTraceBinding, RestirBinding, SceneBinding};
+use restir_pt::shading::path_record::PathRecord;
 use restir_pt::vk::{check_bindings, compile_kernel, reflect_bindings, Binding, BindingSlot};
 
 const OP_NAME: u32 = 5;
