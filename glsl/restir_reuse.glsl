@@ -11,9 +11,6 @@
 #include "gris.glsl"
 #include "shift.glsl"
 
-#define SHIFT_RECONNECTION 0
-#define SHIFT_REPLAY 1
-#define SHIFT_HYBRID 2
 #ifndef SHIFT_MODE
 #define SHIFT_MODE SHIFT_HYBRID
 #endif
