@@ -57,12 +57,12 @@ fn describe_extension(name: &str) -> &'static str {
 const GLB_MAGIC: &[u8; 4] = b"glTF";
 const GLB_HEADER_BYTES: usize = 12;
 
-/// Splits GLB into its JSON and binary chunks, or takes the bytes as glTF JSON. A GLB header whose
-/// length is shorter than the header itself makes the gltf crate's subtraction overflow (found by
-/// fuzzing), so it is checked first.
 /// A file's JSON and, for GLB, its binary chunk.
 type GltfChunks<'a> = (Cow<'a, [u8]>, Option<Vec<u8>>);
 
+/// Splits GLB into its JSON and binary chunks, or takes the bytes as glTF JSON. A GLB header whose
+/// length is shorter than the header itself makes the gltf crate's subtraction overflow (found by
+/// fuzzing), so it is checked first.
 fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<GltfChunks<'a>> {
     if !bytes.starts_with(GLB_MAGIC) {
         // Borrowed: a .gltf with embedded data can be hundreds of megabytes.
