@@ -118,12 +118,4 @@ void segment_ray(vec3 p, vec3 np, uint tp, vec3 q, vec3 nq, uint tq, out vec3 or
     tmax = 1.0 - SEGMENT_EPSILON;
 }
 
-// Whether anything blocks the segment between surface points p and q (see segment_ray).
-bool segment_occluded(vec3 p, vec3 np, uint tp, vec3 q, vec3 nq, uint tq) {
-    vec3 origin, dir;
-    float tmax;
-    segment_ray(p, np, tp, q, nq, tq, origin, dir, tmax);
-    return trace_occluded(origin, dir, tmax);
-}
-
 #endif
