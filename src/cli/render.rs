@@ -115,7 +115,7 @@ impl RenderArgs {
             MethodArg::Pt => {
                 let ignored = self.restir.changed_flags();
                 if !ignored.is_empty() {
-                    eprintln!("warning: {} set ReSTIR PT and are ignored by --method pt", ignored.join(", "));
+                    eprintln!("warning: --method pt ignores the ReSTIR PT options {}", ignored.join(", "));
                 }
             }
         }
