@@ -12,7 +12,7 @@ use super::scene_path;
 use super::sweep::SweepMode;
 use crate::image_io::Exposure;
 use crate::render::{RenderSettings, RestirSettings, ReuseMis, ShiftKind};
-use crate::scene::LoadOptions;
+use crate::scene::{ArrayLimit, LoadOptions};
 
 /// An on/off switch written `--flag on|off`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -163,13 +163,14 @@ impl SceneArgs {
         scene_path(self.scene.as_deref())
     }
 
-    /// What to load besides the file; `max_binding_bytes` is the device's per-binding limit.
-    pub fn load_options(&self, max_binding_bytes: Option<u64>) -> LoadOptions {
+    /// What to load besides the file; `array_limit` is the device's limit on one scene array
+    /// (`Context::scene_array_limit`), None before a device is open.
+    pub fn load_options(&self, array_limit: Option<ArrayLimit>) -> LoadOptions {
         LoadOptions {
             scene: self.scene_index,
             environment: self.env.as_ref().and_then(EnvArg::constant),
             environment_map: self.env.as_ref().and_then(EnvArg::file),
-            max_binding_bytes,
+            array_limit,
         }
     }
 }

@@ -4,6 +4,7 @@
 
 mod args;
 mod bench;
+pub mod charts;
 mod compare;
 mod compare_outputs;
 mod compare_sweep;
@@ -80,6 +81,7 @@ pub fn open_device(args: &DeviceArgs) -> Result<Arc<Context>> {
     let ctx = Context::new(&ContextOptions {
         device: args.device.clone(),
         validation: args.validation(),
+        ..Default::default()
     })?;
     eprintln!("device: {} ({:?})", ctx.info.name, ctx.info.device_type);
     Ok(Arc::new(ctx))

@@ -239,10 +239,10 @@ pub fn render(args: RenderArgs) -> Result<()> {
     }
     args.check_method_flags()?;
     let path = args.scene.path();
-    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;
-    let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.info.max_storage_buffer_range)))?;
+    let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.scene_array_limit())))?;
     if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
         eprintln!(
             "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",

@@ -3,8 +3,8 @@
 use anyhow::{bail, Result};
 
 use crate::gpu_types::{FrameParams, FLAG_RUSSIAN_ROULETTE};
-use crate::path_record::MAX_PATH_LENGTH;
 use crate::scene::Scene;
+use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// Sides beyond this are refused: per-pixel indices stay far inside u32, and 8x8 workgroups
 /// stay within 8192 per axis, below the 65535 every Vulkan device supports.

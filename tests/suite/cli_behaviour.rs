@@ -4,8 +4,8 @@
 //! material value.
 
 use glam::Vec3;
-use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::image_io::read_exr;
+use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
 use crate::cli::{assert_clean_failure, restir_pt};
 use crate::common::temp_file;
