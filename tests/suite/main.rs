@@ -7,6 +7,7 @@ mod bench_cli;
 mod bsdf_oracle;
 mod bvh_oracle;
 mod cli;
+mod cli_behaviour;
 mod dielectric_furnace;
 mod furnace;
 mod gris;
