@@ -6,6 +6,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+#include "restir_bindings.glsl"
 #include "restir_candidates.glsl"
 #include "camera.glsl"
 
