@@ -61,7 +61,7 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     hit.bary = vec2(0.0);
     vec3 inv_d = safe_inverse(d);
     vec3 o_inv_d = o * inv_d;
-    uint end = nodes.length();
+    uint end = SCENE_NODES_LENGTH;
     uint node = 0u;
     count_lane(COUNTER_TRAVERSALS);
     while (node < end) {

@@ -9,9 +9,16 @@ use restir_pt::vk::{Binding, Buffer, Context, ContextOptions, Kernel};
 pub const NAN_FILL: u32 = 0x7fc0_0000;
 
 pub fn gpu() -> Arc<Context> {
+    gpu_with_scene_binding_limit(None)
+}
+
+/// A validated context whose scene arrays past `limit` bytes are reached by device address
+/// (`ContextOptions::scene_binding_limit`): small scenes then take the large-scene path.
+pub fn gpu_with_scene_binding_limit(limit: Option<u64>) -> Arc<Context> {
     let ctx = Context::new(&ContextOptions {
         device: None,
         validation: true,
+        scene_binding_limit: limit,
     })
     .expect("a Vulkan device with validation layers (tools/setup.sh)");
     Arc::new(ctx)
@@ -38,11 +45,11 @@ pub fn run_oracle<T: bytemuck::Pod>(
     output_words: usize,
     count: u32,
 ) -> Vec<T> {
-    run_oracle_defined(ctx, kernel, &[], leading, inputs, output_words, count)
+    run_oracle_with_defines(ctx, kernel, &[], leading, inputs, output_words, count)
 }
 
-/// `run_oracle` of the kernel compiled with `defines` (name, value).
-pub fn run_oracle_defined<T: bytemuck::Pod>(
+/// `run_oracle` with the kernel compiled with `defines`.
+pub fn run_oracle_with_defines<T: bytemuck::Pod>(
     ctx: &Arc<Context>,
     kernel: &str,
     defines: &[(&str, &str)],

@@ -21,6 +21,7 @@ mod rng_oracle;
 mod robustness;
 mod sampling_oracle;
 mod sampling_statistics;
+mod scale;
 mod scale_invariance;
 mod scene_loader;
 mod scenes;

@@ -91,7 +91,7 @@ fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, job
         .iter()
         .flat_map(|j| [j.v1.pos.extend(f32::from_bits(j.v1.triangle)), camera.extend(0.0)])
         .collect();
-    let out = crate::common::run_oracle_defined(
+    let out = crate::common::run_oracle_with_defines(
         &ctx,
         "oracle/shift_oracle.comp",
         &[("ORACLE_SHIFT", &function.to_string())],
