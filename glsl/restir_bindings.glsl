@@ -158,8 +158,4 @@ void report_pass_stats() {
     }
 }
 
-bool is_finite(float x) {
-    return !isnan(x) && !isinf(x);
-}
-
 #endif

@@ -8,6 +8,7 @@
 
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
+#include "restir_bindings.glsl"
 #include "restir_candidates.glsl"
 #include "camera.glsl"
 
