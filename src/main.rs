@@ -536,7 +536,7 @@ fn main() -> ExitCode {
                 scene: r.scene_index,
                 environment: r.env.as_ref().and_then(EnvOpt::constant),
                 environment_map: r.env.as_ref().and_then(EnvOpt::file),
-                max_binding_bytes: None,
+                array_limit: None,
             },
             exposure: r.exposure,
             device: r.device.into(),

@@ -81,6 +81,7 @@ pub fn open_device(args: &DeviceArgs) -> Result<Arc<Context>> {
     let ctx = Context::new(&ContextOptions {
         device: args.device.clone(),
         validation: args.validate,
+        ..Default::default()
     })?;
     eprintln!("device: {} ({:?})", ctx.info.name, ctx.info.device_type);
     Ok(Arc::new(ctx))

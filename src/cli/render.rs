@@ -174,11 +174,11 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
         bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
     }
-    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;
     let load = LoadOptions {
-        max_binding_bytes: Some(ctx.info.max_storage_buffer_range),
+        array_limit: Some(ctx.scene_array_limit()),
         ..args.load.clone()
     };
     let scene = load_with_options(&path, &load)?;
