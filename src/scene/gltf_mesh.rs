@@ -239,7 +239,10 @@ impl Loader<'_> {
         ];
         for (name, accessor) in read {
             if accessor.is_some_and(|a| a.count() == 0) {
-                bail!(problem(self.path, format!("mesh {}: the {name} accessor has count 0", mesh.index())));
+                bail!(problem(
+                    self.path,
+                    format!("mesh {}: the {name} accessor has count 0", mesh.index())
+                ));
             }
         }
         if let Some(p) = prim.get(&gltf::Semantic::Positions) {
