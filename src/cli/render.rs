@@ -401,9 +401,18 @@ fn render_restir(
     print_compile_summary(&compile_reports);
     let mut gpu_ms = 0.0;
     let mut report = None;
+    // Whether an estimate accumulated since the last restart was non-finite (counted on the
+    // GPU): only then can the image hold non-finite pixels.
+    let mut nonfinite_seen = false;
     for frame in 0..args.frames {
         let stats = renderer.frame(scene, frame_camera(args, frame, scene.cameras.len()), args.static_camera)?;
-        let image = renderer.image()?;
+        let interrupted = interrupt.load(Ordering::Relaxed);
+        let last = frame + 1 == args.frames || interrupted;
+        nonfinite_seen = (nonfinite_seen && args.static_camera) || stats.counters.nonfinite_pixels > 0;
+        // The image is read back only when it is written or has non-finite pixels to count.
+        let image = (last || outputs.out_dir.is_some() || nonfinite_seen)
+            .then(|| renderer.image())
+            .transpose()?;
         let frame_ms = stats.gpu_ms().unwrap_or(stats.wall_ms);
         gpu_ms += frame_ms;
         let detail = RestirFrameReport::from_stats(frame + 1, &stats);
@@ -419,7 +428,7 @@ fn render_restir(
             wall_ms: stats.wall_ms,
             paths_per_second: settings.pixel_count() as f64 * (restir.candidates * restir.reservoirs) as f64 / (frame_ms * 1e-3),
             compile_ms: compile_reports.iter().map(|k| k.total_ms()).sum(),
-            nonfinite_pixels: image.non_finite_count(),
+            nonfinite_pixels: image.as_ref().map_or(0, |i| i.non_finite_count()),
             nonfinite_weights: detail.nonfinite_weights as u64,
             restir: Some(detail.clone()),
         };
@@ -430,12 +439,12 @@ fn render_restir(
             detail.summary()
         );
         guard_nonfinite(args, frame, &frame_report)?;
+        let Some(image) = image else { continue };
         outputs.write_frame(frame, &image)?;
-        let interrupted = interrupt.load(Ordering::Relaxed);
         if interrupted {
             eprintln!("interrupted: writing frame {frame}");
         }
-        if frame + 1 == args.frames || interrupted {
+        if last {
             outputs.write_final(&image)?;
             report = Some(frame_report);
             break;
