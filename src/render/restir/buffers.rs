@@ -8,7 +8,7 @@ use anyhow::Result;
 use super::super::reservoir_layers::ReservoirLayers;
 use super::super::SceneGpu;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
-use crate::shader_interface::RestirBinding;
+use crate::shader_interface::{RestirBinding, SURFACE_SLOTS};
 use crate::vk::{BoundBuffer, Buffer, BufferUsage, Context};
 
 pub(super) struct RestirBuffers {
@@ -17,7 +17,7 @@ pub(super) struct RestirBuffers {
     /// `ReuseParams` with the frame's pass table, host-written before each frame.
     pub reuse: Buffer,
     /// Each pixel's surface, this frame's and the previous one's, shared by its reservoirs.
-    pub surfaces: [Buffer; 2],
+    pub surfaces: [Buffer; SURFACE_SLOTS],
     pub layers: ReservoirLayers,
     pub accum: Buffer,
     pub accum_sq: Buffer,
@@ -53,11 +53,10 @@ impl RestirBuffers {
         use RestirBinding as B;
         let layers = &self.layers;
         let mut table = scene.buffers(&self.params);
-        table.extend([
-            B::ReuseParams.to(&self.reuse),
-            B::Surfaces0.to(&self.surfaces[0]),
-            B::Surfaces1.to(&self.surfaces[1]),
-        ]);
+        table.push(B::ReuseParams.to(&self.reuse));
+        for (slot, surfaces) in self.surfaces.iter().enumerate() {
+            table.push(B::surface_slot(slot).to(surfaces));
+        }
         for (slot, (heads, tails)) in layers.heads.iter().zip(&layers.tails).enumerate() {
             let (head_binding, tail_binding) = B::reservoir_slot(slot);
             table.extend([head_binding.to(heads), tail_binding.to(tails)]);
