@@ -6,7 +6,7 @@ use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// The shift mapping used for reuse (and, inverted, for its MIS weights). The discriminant is
 /// the value of the kernels' SHIFT_MODE (src/shader_interface.rs writes the GLSL names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 #[repr(u32)]
 pub enum ShiftKind {
     Reconnection = 0,
@@ -14,13 +14,15 @@ pub enum ShiftKind {
     Hybrid = 2,
 }
 
-/// The resampling MIS weights of reuse. The discriminant is the value of the kernels' MIS_MODE.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The resampling MIS weights of reuse (`--mis gbh|pairwise`). The discriminant is the value of
+/// the kernels' MIS_MODE.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 #[repr(u32)]
 pub enum ReuseMis {
-    /// Generalized balance heuristic with confidence weights, O(M^2) inverse shifts.
+    /// Generalized balance heuristic with confidence weights (O(M^2) shifts).
+    #[value(name = "gbh")]
     GeneralizedBalance = 0,
-    /// Defensive pairwise MIS, O(M).
+    /// Defensive pairwise MIS (O(M) shifts).
     Pairwise = 1,
 }
 
