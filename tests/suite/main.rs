@@ -6,6 +6,7 @@ mod common;
 mod bench_cli;
 mod bsdf_oracle;
 mod bvh_oracle;
+mod candidates_oracle;
 mod cli;
 mod cli_behaviour;
 mod dielectric_furnace;
