@@ -97,6 +97,8 @@ bool vertex_is_rough(Vertex v, ShiftParams params) {
     Material m = material_of(v);
     float w_d, w_c, w_t;
     lobe_weights(m, w_d, w_c, w_t);
+    // A non-metal's specular layer is a GGX lobe too.
+    if (w_d > 0.0 && m.specular > 0.0) w_c = 1.0;
     bool rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
     return (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)));
 }

@@ -23,7 +23,7 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, has_specular_layer, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
 use crate::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::{
@@ -184,13 +184,15 @@ impl ShiftResult {
 }
 
 /// Whether a vertex may be a reconnection endpoint: every lobe of its material is rough
-/// (diffuse, or GGX at least as rough as the threshold). Escaped directions count as rough.
+/// (diffuse, or GGX, including a non-metal's specular layer, at least as rough as the threshold).
+/// Escaped directions count as rough.
 pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool {
     if v.is_escaped() || v.is_punctual() {
         return true;
     }
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
     let (_, w_c, w_t) = lobe_weights(m);
+    let w_c = if has_specular_layer(m) { 1.0 } else { w_c };
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
     // An index-matched dielectric is a pass-through, a delta lobe at any roughness.
     (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)))

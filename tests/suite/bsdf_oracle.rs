@@ -26,12 +26,21 @@ pub fn random_material(r: &mut TestRng) -> Material {
         3 => (r.uniform(), 0.0),
         _ => (r.uniform(), r.uniform()),
     };
+    // The non-metal's specular layer: absent (Lambertian), the core spec's, or a
+    // KHR_materials_specular strength and tint (a tint up to 25 reaches F0 = 1 in a channel).
+    let (specular, specular_color) = match (r.uniform() * 3.0) as u32 {
+        0 => (0.0, [0.0; 3]),
+        1 => (1.0, [1.0; 3]),
+        _ => (r.uniform(), [25.0 * r.uniform(), 25.0 * r.uniform(), 25.0 * r.uniform()]),
+    };
     Material {
         base_color: [0.05 + 0.95 * r.uniform(), 0.05 + 0.95 * r.uniform(), 0.05 + 0.95 * r.uniform()],
         metallic,
         roughness,
         transmission,
         ior: 1.0 + 1.5 * r.uniform(),
+        specular,
+        specular_color,
         ..Default::default()
     }
 }
@@ -40,7 +49,9 @@ fn near_decision(m: &Material, n: Vec3, wo: Vec3, u: Vec4) -> bool {
     let (w_d, w_c, _) = lobe_weights(m);
     let cos_o = n.dot(wo);
     let fr_smooth = fresnel_dielectric(cos_o, m.ior);
+    let p_layer = w_d * specular_layer_fresnel(m, cos_o).max_element();
     (u.z - w_d).abs() < DECISION_MARGIN
+        || (u.z - (w_d - p_layer)).abs() < DECISION_MARGIN
         || (u.z - (w_d + w_c)).abs() < DECISION_MARGIN
         || (u.w - fr_smooth).abs() < DECISION_MARGIN
         || cos_o.abs() < 1e-3

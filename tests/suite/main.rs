@@ -23,6 +23,7 @@ mod scale_invariance;
 mod scene_loader;
 mod scenes;
 mod shift;
+mod specular_layer;
 mod speed_accuracy;
 mod sweeps;
 mod trace_pair_oracle;

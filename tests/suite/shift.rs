@@ -524,7 +524,7 @@ struct Causes {
 
 #[test]
 fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
-    use restir_pt::bsdf::{bsdf_eval_pdf, lobe_weights};
+    use restir_pt::bsdf::{bsdf_eval_pdf, has_specular_layer, lobe_weights};
     use restir_pt::bvh::trace_occluded;
     use restir_pt::ray_offset::offset_ray_origin;
     let mut total = Causes::default();
@@ -539,7 +539,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
             let is_delta = |v: &Vertex| {
                 let m = material(v);
                 let (_, w_c, w_t) = lobe_weights(&m);
-                (w_c > 0.0 || w_t > 0.0) && m.roughness * m.roughness < restir_pt::bsdf::DELTA_ALPHA
+                (w_c > 0.0 || w_t > 0.0 || has_specular_layer(&m)) && m.roughness * m.roughness < restir_pt::bsdf::DELTA_ALPHA
             };
             let check = |result: &ShiftResult, what: &str| {
                 assert!(
