@@ -1,6 +1,7 @@
 // The material model (docs/materials.md): a linear blend of a Lambertian lobe under a GGX
-// specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric. All directions point away from the surface; n is the geometric
-// normal as wound. Twin: src/bsdf.rs.
+// specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric. All
+// directions point away from the surface; n is the geometric normal as wound.
+// Twin: src/shading/bsdf.rs.
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
 

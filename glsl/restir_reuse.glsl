@@ -1,6 +1,6 @@
 // GRIS across pixels and frames (../shared/docs/math.md sections 2-4): inputs from other domains
 // are shifted into the canonical pixel's domain, weighted by resampling MIS weights computed with
-// inverse shifts, and one is chosen. Twin of src/gris.rs (mis_weight, resample), whose toy test
+// inverse shifts, and one is chosen. Twin of src/shading/gris.rs (mis_weight, resample), whose toy test
 // checks the estimator; SHIFT_MODE and MIS_MODE select the shift and the MIS at compile time.
 #ifndef RESTIR_REUSE_GLSL
 #define RESTIR_REUSE_GLSL

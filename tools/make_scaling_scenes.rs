@@ -12,7 +12,7 @@ fn main() -> anyhow::Result<()> {
     std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
     for (name, rings, segments) in [("1e2", 5, 8), ("1e4", 50, 100), ("1e6", 500, 1000)] {
         let path = dir.join(format!("cornell-sphere-{name}.gltf"));
-        let gltf = restir_pt::bundled_scenes::cornell_sphere(rings, segments);
+        let gltf = restir_pt::scene::bundled_scenes::cornell_sphere(rings, segments);
         std::fs::write(&path, gltf).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
         println!("wrote {}", path.display());
     }

@@ -1,6 +1,6 @@
 #version 460
 // Oracle kernel: one shift (or its inverse) per item on records the host made
-// (twin: src/shift.rs).
+// (twin: src/shading/shift.rs).
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 

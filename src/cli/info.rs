@@ -26,7 +26,7 @@ pub fn info(path: &Path, options: &LoadOptions, kernels: Option<(RestirSettings,
         let settings = RenderSettings {
             width: 8,
             height: 8,
-            max_depth: crate::path_record::MAX_PATH_LENGTH as u32,
+            max_depth: crate::shading::path_record::MAX_PATH_LENGTH as u32,
             ..Default::default()
         };
         let mut reports = vec![PathTracer::new(&ctx, &scene, &settings)?.compile_report().clone()];

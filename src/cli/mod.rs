@@ -1,6 +1,7 @@
 //! The commands behind the CLI; main.rs only parses arguments into these structs.
 
 mod bench;
+pub mod charts;
 mod compare;
 mod compare_outputs;
 mod compare_sweep;

@@ -19,7 +19,7 @@ use super::sweep::{
     SweepMode, COMMIT,
 };
 use super::{bundled_file, finish_device, load_with_warnings, open_device, DeviceArgs};
-use crate::charts::{write_line_chart, LineChart, Series};
+use crate::cli::charts::{write_line_chart, LineChart, Series};
 use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
 use crate::render::{PathTracer, RenderSettings, RestirSettings};
 use crate::scene::{camera_on_path, Scene};
@@ -120,7 +120,7 @@ fn scene_name(path: &Path) -> String {
 
 /// The bundled scenes, in their documented order.
 pub fn bundled_scene_paths() -> Vec<PathBuf> {
-    crate::bundled_scenes::BUNDLED_SCENES
+    crate::scene::bundled_scenes::BUNDLED_SCENES
         .iter()
         .map(|s| bundled_file(&Path::new("scenes").join(s.file_name)))
         .collect()

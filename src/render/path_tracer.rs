@@ -8,8 +8,8 @@ use anyhow::{Context as _, Result};
 
 use super::counters::{TraversalCounters, COUNTER_COUNT};
 use super::{Image, RenderSettings, SceneGpu};
-use crate::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::error::GpuError;
+use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::scene::Scene;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Result};
 
-use crate::path_record::MAX_PATH_LENGTH;
+use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// The shift mapping used for reuse (and, inverted, for its MIS weights).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

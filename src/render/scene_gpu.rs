@@ -6,10 +6,10 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 use ash::vk::PhysicalDeviceType;
 
-use crate::bsdf::{has_specular_layer, lobe_weights};
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
+use crate::shading::bsdf::{has_specular_layer, lobe_weights};
 use crate::vk::{Binding, Buffer, Context};
 
 pub struct SceneGpu {

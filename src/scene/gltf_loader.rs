@@ -9,8 +9,8 @@ use glam::{DMat4, DVec3, Vec3};
 
 use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
-use crate::environment::EnvironmentMap;
 use crate::gpu_types::{Material, Triangle};
+use crate::scene::environment::EnvironmentMap;
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
 pub(super) const MAX_NODE_DEPTH: usize = 256;

@@ -86,7 +86,7 @@ impl TestRng {
         (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
     }
     pub fn unit_vector(&mut self) -> glam::Vec3 {
-        restir_pt::sampling::sample_uniform_sphere(glam::Vec2::new(self.uniform(), self.uniform()))
+        restir_pt::shading::sampling::sample_uniform_sphere(glam::Vec2::new(self.uniform(), self.uniform()))
     }
 }
 

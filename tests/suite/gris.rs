@@ -5,7 +5,7 @@
 //! The selection-free estimator the renderer shades with (`resampled_expectation`) is unbiased
 //! too, for an integrand that is not the target function, and has a lower variance.
 
-use restir_pt::gris::{resample, resampled_expectation, Domains, Input, Mis};
+use restir_pt::shading::gris::{resample, resampled_expectation, Domains, Input, Mis};
 
 use crate::common::TestRng;
 

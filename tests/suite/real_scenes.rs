@@ -376,7 +376,7 @@ fn real_scenes_every_shared_asset_renders_with_restir() {
 
 #[test]
 fn real_scenes_binding_limit_is_checked_from_accessor_counts_before_loading() {
-    use restir_pt::bundled_scenes::{tiled_floor, TILE_TRIANGLES};
+    use restir_pt::scene::bundled_scenes::{tiled_floor, TILE_TRIANGLES};
     // 2^3 tiles through a node tree: the estimate follows node instances.
     let path = crate::common::temp_file("floor3.gltf", tiled_floor(3).as_bytes());
     let bytes = (8 * TILE_TRIANGLES * 48) as u64;

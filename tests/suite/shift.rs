@@ -1,13 +1,13 @@
-//! The shift mappings' Rust reference (src/shift.rs) on the bundled scenes: round trips,
+//! The shift mappings' Rust reference (src/shading/shift.rs) on the bundled scenes: round trips,
 //! reciprocal Jacobians, finite-difference Jacobians, injectivity and clean failure.
 //! `cargo test --release shift` runs them all.
 
 use std::collections::HashSet;
 
 use glam::Vec3;
-use restir_pt::path_record::PathRecord;
 use restir_pt::scene::{load_scene, Scene};
-use restir_pt::shift::*;
+use restir_pt::shading::path_record::PathRecord;
+use restir_pt::shading::shift::*;
 
 use crate::common::{repo_path, TestRng};
 
@@ -287,7 +287,7 @@ fn check_jacobian_finite_difference(kind: Kind) {
                 continue;
             }
             let p = x_r.pos.as_dvec3();
-            let (t1, t2) = restir_pt::sampling::build_onb(x_r.normal);
+            let (t1, t2) = restir_pt::shading::sampling::build_onb(x_r.normal);
             let (a, b) = (p + h * t1.as_dvec3(), p + h * t2.as_dvec3());
             let omega_y = solid_angle(y.vertices[r - 2].pos.as_dvec3(), p, a, b);
             let omega_x = solid_angle(case.base.vertices[r - 2].pos.as_dvec3(), p, a, b);
@@ -349,7 +349,7 @@ fn near_threshold(kind: Kind, scene: &Scene, params: &ShiftParams, case: &Case, 
         })
 }
 
-/// GLSL glsl/shift.glsl against src/shift.rs: 10^4 base paths per scene, each shifted on the GPU
+/// GLSL glsl/shift.glsl against src/shading/shift.rs: 10^4 base paths per scene, each shifted on the GPU
 /// and in Rust. Validity, the rebuilt vertices (within 1e-4 of the scene's extent), the Jacobian
 /// and the contribution agree within 1e-4 relative (random replay: within 1e-3, and at most 0.1%
 /// beyond 1e-4), the record's cached terms within 1e-3. Inputs within 1e-3 of the distance or
@@ -524,9 +524,9 @@ struct Causes {
 
 #[test]
 fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
-    use restir_pt::bsdf::{bsdf_eval_pdf, has_specular_layer, lobe_weights};
-    use restir_pt::bvh::trace_occluded;
-    use restir_pt::ray_offset::offset_ray_origin;
+    use restir_pt::scene::bvh::trace_occluded;
+    use restir_pt::shading::bsdf::{bsdf_eval_pdf, has_specular_layer, lobe_weights};
+    use restir_pt::shading::ray_offset::offset_ray_origin;
     let mut total = Causes::default();
     let mut diverged = 0;
     for name in ["mirror", "glass", "near-field", "cornell", "veach-door"] {
@@ -539,7 +539,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
             let is_delta = |v: &Vertex| {
                 let m = material(v);
                 let (_, w_c, w_t) = lobe_weights(&m);
-                (w_c > 0.0 || w_t > 0.0 || has_specular_layer(&m)) && m.roughness * m.roughness < restir_pt::bsdf::DELTA_ALPHA
+                (w_c > 0.0 || w_t > 0.0 || has_specular_layer(&m)) && m.roughness * m.roughness < restir_pt::shading::bsdf::DELTA_ALPHA
             };
             let check = |result: &ShiftResult, what: &str| {
                 assert!(

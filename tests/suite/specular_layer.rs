@@ -7,7 +7,7 @@
 use std::f64::consts::PI;
 
 use glam::{Vec3, Vec4};
-use restir_pt::bsdf::{bsdf_eval_pdf, bsdf_sample, specular_layer_fresnel, DELTA_ALPHA, LOBE_NONE};
+use restir_pt::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, specular_layer_fresnel, DELTA_ALPHA, LOBE_NONE};
 use restir_pt::gpu_types::Material;
 
 use crate::common::{assert_clean, gpu, run_oracle, TestRng};
@@ -229,7 +229,7 @@ fn specular_layer_roughness_changes_the_bsdf_and_the_image() {
 
 /// A white non-metal floor under a small bright quad light, seen at the light's mirror angle.
 fn render_highlight(ctx: &std::sync::Arc<restir_pt::vk::Context>, roughness: f32, specular: f32) -> restir_pt::render::Image {
-    use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+    use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
     use restir_pt::render::{PathTracer, RenderSettings};
     let mut b = GltfBuilder::default();
     let floor = b.material(

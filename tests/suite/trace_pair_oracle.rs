@@ -1,12 +1,12 @@
-//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (src/bvh.rs), in
+//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (src/scene/bvh.rs), in
 //! both forms: the BVH traversed once for a closest-hit and a shadow ray, and the brute-force
 //! pass of small uniform-buffer scenes; and the twin against `trace_closest`/`trace_occluded`.
 
 use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
-use restir_pt::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::render::{RenderSettings, SceneGpu};
+use restir_pt::scene::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::scene::{load_scene, Scene};
 use restir_pt::vk::{Buffer, BufferUsage, Context, Kernel};
 

@@ -1,6 +1,6 @@
 //! Shift mappings of ReSTIR PT in the primary-sample-space (PSS) measure: the Rust reference that
 //! glsl/shift.glsl is to mirror. A path is regenerated from its primary hit and its seed (the
-//! counter-based RNG of src/rng.rs), so random replay needs nothing else; reconnection and hybrid
+//! counter-based RNG of src/shading/rng.rs), so random replay needs nothing else; reconnection and hybrid
 //! keep the base path's suffix from the reconnection vertex x_r on.
 //!
 //! Contribution f(X) of a path x0 (camera), x1 (primary hit), ..., xk: the product over the
@@ -23,19 +23,19 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, has_specular_layer, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
-use crate::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
-use crate::lights::{
+use crate::scene::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
+use crate::scene::PunctualKind;
+use crate::scene::Scene;
+use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, has_specular_layer, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::shading::lights::{
     emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
     punctual_pdf, sample_light,
 };
-use crate::path_record::{PathRecord, MAX_PATH_LENGTH};
-use crate::ray_offset::offset_ray_origin;
-use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
-use crate::sampling::balance_heuristic;
-use crate::scene::PunctualKind;
-use crate::scene::Scene;
+use crate::shading::path_record::{PathRecord, MAX_PATH_LENGTH};
+use crate::shading::ray_offset::offset_ray_origin;
+use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
+use crate::shading::sampling::balance_heuristic;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
 pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
@@ -381,7 +381,7 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
     Some(path)
 }
 
-fn hit_vertex(scene: &Scene, hit: crate::bvh::Hit) -> Vertex {
+fn hit_vertex(scene: &Scene, hit: crate::scene::bvh::Hit) -> Vertex {
     let t = &scene.triangles[hit.triangle as usize];
     Vertex::on_surface(
         scene,

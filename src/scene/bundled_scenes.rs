@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+use crate::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
 pub struct BundledScene {
     pub file_name: &'static str,

@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::gpu_types::{BvhNode, Triangle, LEAF_COUNT_BITS, LEAF_COUNT_MASK};
-use crate::ray_offset::offset_ray_origin;
+use crate::shading::ray_offset::offset_ray_origin;
 
 pub const NO_HIT: u32 = u32::MAX;
 const SAH_BINS: usize = 16;

@@ -6,8 +6,8 @@
 use glam::{Vec2, Vec3};
 
 use crate::gpu_types::{Emitter, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
-use crate::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 use crate::scene::{PunctualKind, PunctualLight, Scene};
+use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightSample {
@@ -58,8 +58,8 @@ pub fn punctual_arrival(light: &PunctualLight, p: Vec3) -> (Vec3, f32, Vec3) {
 /// to a punctual light along the unit `dir` at distance `dist` (infinite: a directional light);
 /// only x is offset, the light being a point in the air. Twin of GLSL `punctual_occluded` (glsl/punctual.glsl).
 pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, tri: u32, dir: Vec3, dist: f32) -> bool {
-    use crate::bvh::{trace_occluded, SEGMENT_EPSILON};
-    let origin = crate::ray_offset::offset_ray_origin(x, if dir.dot(n) > 0.0 { n } else { -n }, &scene.triangles[tri as usize]);
+    use crate::scene::bvh::{trace_occluded, SEGMENT_EPSILON};
+    let origin = crate::shading::ray_offset::offset_ray_origin(x, if dir.dot(n) > 0.0 { n } else { -n }, &scene.triangles[tri as usize]);
     if dist.is_infinite() {
         return trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
     }
