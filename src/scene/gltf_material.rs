@@ -82,7 +82,10 @@ impl Loader<'_> {
             ("emissive", m.emissive_texture().is_some()),
             ("transmission", m.transmission().is_some_and(|t| t.transmission_texture().is_some())),
             ("specular", m.specular().is_some_and(|s| s.specular_texture().is_some())),
-            ("specular colour", m.specular().is_some_and(|s| s.specular_color_texture().is_some())),
+            (
+                "specular colour",
+                m.specular().is_some_and(|s| s.specular_color_texture().is_some()),
+            ),
             ("diffuse", sg.as_ref().is_some_and(|s| s.diffuse_texture().is_some())),
             (
                 "specular-glossiness",

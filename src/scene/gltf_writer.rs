@@ -204,10 +204,7 @@ impl GltfBuilder {
             self.use_extension("KHR_materials_ior");
         }
         if m.specular != 1.0 && m.metallic < 1.0 && m.transmission < 1.0 {
-            extensions.insert(
-                "KHR_materials_specular".into(),
-                json!({ "specularFactor": round6(m.specular) }),
-            );
+            extensions.insert("KHR_materials_specular".into(), json!({ "specularFactor": round6(m.specular) }));
             self.use_extension("KHR_materials_specular");
         }
         if !extensions.is_empty() {
