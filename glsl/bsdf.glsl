@@ -1,6 +1,7 @@
 // The material model (docs/materials.md): a linear blend of a Lambertian lobe under a GGX
 // specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric. All
-// directions point away from the surface; n is the geometric normal as wound.
+// directions point away from the surface. BSDFs evaluate in the shading frame (normal ns); the
+// geometric normal ng (as wound) decides sides (docs/materials.md, "Shading normals").
 // Twin: src/shading/bsdf.rs.
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
@@ -193,8 +194,23 @@ void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float
     }
 }
 
-// f * |cos_i| of the non-delta lobes, and in `pdf` the solid-angle pdf of bsdf_sample producing wi.
-vec3 bsdf_eval_pdf(Material m, vec3 n, vec3 wo, vec3 wi, out float pdf) {
+// pbrt-v4's orientation (SurfaceInteraction::SetShadingGeometry): the shading normal is turned
+// into the geometric normal's hemisphere.
+vec3 shading_normal_facing(vec3 ng, vec3 ns) { return dot(ns, ng) < 0.0 ? -ns : ns; }
+
+// Mitsuba's strict normals: a direction that lies on different sides of the geometric and the
+// shading normal carries nothing (no light leaks through the surface, no reflection into it).
+bool sides_agree(vec3 ng, vec3 ns, vec3 w) {
+    float a = dot(w, ng), b = dot(w, ns);
+    return (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0);
+}
+
+// f * |cos_i| (the cosine against the shading normal) of the non-delta lobes, and in `pdf` the
+// solid-angle pdf of bsdf_sample producing wi; ng geometric, ns shading normal (unit).
+vec3 bsdf_eval_pdf(Material m, vec3 ng, vec3 ns, vec3 wo, vec3 wi, out float pdf) {
+    vec3 n = shading_normal_facing(ng, ns);
+    pdf = 0.0;
+    if (!sides_agree(ng, n, wo) || !sides_agree(ng, n, wi)) return vec3(0.0);
     vec3 t, b;
     build_onb(n, t, b);
     vec3 f_cos;
@@ -202,8 +218,8 @@ vec3 bsdf_eval_pdf(Material m, vec3 n, vec3 wo, vec3 wi, out float pdf) {
     return f_cos;
 }
 
-// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
-BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
+// bsdf_sample in the frame of normal n alone (no side checks).
+BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
     BsdfSample s;
     s.wi = vec3(0.0);
     s.weight = vec3(0.0);
@@ -293,6 +309,21 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
     s.pdf = pdf;
     s.lobe = lobe;
     return s;
+}
+
+// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice; ng geometric, ns
+// shading normal (unit). A sample on different sides of the two normals fails.
+BsdfSample bsdf_sample(Material m, vec3 ng, vec3 ns, vec3 wo_world, vec4 u) {
+    vec3 n = shading_normal_facing(ng, ns);
+    BsdfSample s;
+    s.wi = vec3(0.0);
+    s.weight = vec3(0.0);
+    s.pdf = 0.0;
+    s.lobe = LOBE_NONE;
+    if (!sides_agree(ng, n, wo_world)) return s;
+    BsdfSample r = bsdf_sample_frame(m, n, wo_world, u);
+    if (r.lobe == LOBE_NONE || !sides_agree(ng, n, r.wi)) return s;
+    return r;
 }
 
 #endif

@@ -217,14 +217,53 @@ pub fn bsdf_eval_pdf_local(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     (f_cos, pdf)
 }
 
-/// (f * |cos_i| of the non-delta lobes, solid-angle pdf of `bsdf_sample` producing wi).
-pub fn bsdf_eval_pdf(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+/// pbrt-v4's orientation (`SurfaceInteraction::SetShadingGeometry`): the shading normal `ns`
+/// turned into the geometric normal `ng`'s hemisphere. Twin of GLSL `shading_normal_facing`.
+pub fn shading_normal_facing(ng: Vec3, ns: Vec3) -> Vec3 {
+    if ns.dot(ng) < 0.0 {
+        -ns
+    } else {
+        ns
+    }
+}
+
+/// Mitsuba's strict normals: whether direction `w` lies on the same (strict) side of the
+/// geometric normal `ng` and the shading normal `ns`; a direction where they disagree carries
+/// nothing. Twin of GLSL `sides_agree`.
+pub fn sides_agree(ng: Vec3, ns: Vec3, w: Vec3) -> bool {
+    let (a, b) = (w.dot(ng), w.dot(ns));
+    (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
+}
+
+/// (f * |cos_i| of the non-delta lobes, solid-angle pdf of `bsdf_sample` producing wi), with the
+/// cosine against the shading normal; `ng` geometric, `ns` shading normal (unit, world space).
+/// Zero where wo or wi lies on different sides of the two normals ([`sides_agree`]).
+pub fn bsdf_eval_pdf(m: &Material, ng: Vec3, ns: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+    let n = shading_normal_facing(ng, ns);
+    if !sides_agree(ng, n, wo) || !sides_agree(ng, n, wi) {
+        return (Vec3::ZERO, 0.0);
+    }
     let (t, b) = build_onb(n);
     bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n))
 }
 
-/// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
-pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
+/// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice; `ng` geometric, `ns`
+/// shading normal (unit, world space). A sample on different sides of the two normals fails.
+pub fn bsdf_sample(m: &Material, ng: Vec3, ns: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
+    let n = shading_normal_facing(ng, ns);
+    if !sides_agree(ng, n, wo_world) {
+        return BsdfSample::FAILED;
+    }
+    let s = bsdf_sample_frame(m, n, wo_world, u);
+    if s.lobe == LOBE_NONE || !sides_agree(ng, n, s.wi) {
+        return BsdfSample::FAILED;
+    }
+    s
+}
+
+/// [`bsdf_sample`] in the frame of normal `n` alone (no side checks). Twin of GLSL
+/// `bsdf_sample_frame`.
+pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
     let (t, b) = build_onb(n);
     let wo = to_local(wo_world, t, b, n);
     if wo.z == 0.0 {

@@ -290,7 +290,7 @@ pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee
         return if nee_end { 0.0 } else { 1.0 };
     }
     let (dir, _) = direction(scene, x, end);
-    let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, (before - x.pos).normalize(), dir);
+    let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, x.normal, (before - x.pos).normalize(), dir);
     let light = light_pdf(scene, x, end);
     if nee_end {
         balance_heuristic(light, bsdf_pdf)
@@ -354,9 +354,9 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
             if !visible(scene, &x, &end) {
                 return None;
             }
-            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, wo, ls.dir).0 / ls.pdf)
+            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, x.normal, wo, ls.dir).0 / ls.pdf)
         } else {
-            let s = bsdf_sample(&m, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
+            let s = bsdf_sample(&m, x.normal, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
             if s.lobe == LOBE_NONE {
                 return None;
             }
@@ -520,7 +520,13 @@ struct Link {
 
 fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, nee_at_r: bool) -> Link {
     let (dir, dist) = direction(scene, prev, x_r);
-    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, prev), prev.normal, (before - prev.pos).normalize(), dir);
+    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(
+        &material_of(scene, prev),
+        prev.normal,
+        prev.normal,
+        (before - prev.pos).normalize(),
+        dir,
+    );
     let pdf = if nee_at_r { light_pdf(scene, prev, x_r) } else { bsdf_pdf };
     // A punctual x_r is one fixed point or direction whatever joins it: no area factor.
     let geometry = if x_r.is_escaped() || x_r.is_punctual() {
@@ -535,7 +541,7 @@ fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, n
 /// from x_r (the light's when NEE chose it).
 fn pdf_after(scene: &Scene, x_r: &Vertex, dir_in: Vec3, next: &Vertex, next_is_nee: bool) -> (Vec3, f32) {
     let (dir_next, _) = direction(scene, x_r, next);
-    let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, -dir_in, dir_next);
+    let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, x_r.normal, -dir_in, dir_next);
     (f_cos, if next_is_nee { light_pdf(scene, x_r, next) } else { pdf })
 }
 

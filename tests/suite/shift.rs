@@ -556,7 +556,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
                 let origin = offset_ray_origin(y1.pos, facing(y1.normal, dir), &scene.triangles[y1.triangle as usize]);
                 let target = offset_ray_origin(x2.pos, facing(x2.normal, -dir), &scene.triangles[x2.triangle as usize]);
                 let wo = (camera - y1.pos).normalize();
-                let (f, _) = bsdf_eval_pdf(&material(&y1), y1.normal, wo, dir);
+                let (f, _) = bsdf_eval_pdf(&material(&y1), y1.normal, y1.normal, wo, dir);
                 if is_delta(&y1) || is_delta(&x1) || is_delta(&x2) {
                     check(&rec, "a reconnection at a delta vertex");
                     total.delta += 1;

@@ -73,7 +73,7 @@ fn specular_layer_furnace_never_gains_energy_glsl_and_rust() {
             cases.push((m, wo));
             for _ in 0..SAMPLES {
                 materials.push(m);
-                inputs.extend([Vec4::Z, wo.extend(0.0), Vec4::Z]);
+                inputs.extend([Vec4::Z, Vec4::Z, wo.extend(0.0), Vec4::Z]);
                 inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
             }
         }
@@ -96,7 +96,7 @@ fn specular_layer_furnace_never_gains_energy_glsl_and_rust() {
         let (mut gpu_sum, mut cpu_sum) = (Vec3::ZERO, Vec3::ZERO);
         for k in c * SAMPLES..(c + 1) * SAMPLES {
             let gpu_w = out[3 * k + 2].truncate();
-            let s = bsdf_sample(m, Vec3::Z, *wo, inputs[4 * k + 3]);
+            let s = bsdf_sample(m, Vec3::Z, Vec3::Z, *wo, inputs[5 * k + 4]);
             for (who, w) in [("GLSL", gpu_w), ("Rust", s.weight)] {
                 assert!(
                     w.is_finite() && w.min_element() >= 0.0 && w.max_element() <= 1.0 + 1e-4,
@@ -152,7 +152,13 @@ fn specular_layer_sampling_chi_square() {
         let mut observed = vec![0.0f64; nt * np + 1];
         let mut r = TestRng(77);
         for _ in 0..N {
-            let s = bsdf_sample(&m, Vec3::Z, wo, Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
+            let s = bsdf_sample(
+                &m,
+                Vec3::Z,
+                Vec3::Z,
+                wo,
+                Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()),
+            );
             if s.lobe == LOBE_NONE {
                 observed[nt * np] += 1.0;
             } else {
@@ -174,7 +180,7 @@ fn specular_layer_sampling_chi_square() {
                             (theta.sin() * phi.sin()) as f32,
                             theta.cos() as f32,
                         );
-                        sum += bsdf_eval_pdf(&m, Vec3::Z, wo, w).1 as f64 * theta.sin();
+                        sum += bsdf_eval_pdf(&m, Vec3::Z, Vec3::Z, wo, w).1 as f64 * theta.sin();
                     }
                 }
                 N as f64 * sum * dt * dp / (sub * sub) as f64
@@ -206,7 +212,7 @@ fn specular_layer_roughness_changes_the_bsdf_and_the_image() {
     let wo = Vec3::new(0.6, 0.0, 0.8);
     let mirror = Vec3::new(-0.6, 0.0, 0.8);
     let f = |roughness: f32, specular: f32| {
-        bsdf_eval_pdf(&plastic(roughness, 1.5, specular, Vec3::ONE), Vec3::Z, wo, mirror)
+        bsdf_eval_pdf(&plastic(roughness, 1.5, specular, Vec3::ONE), Vec3::Z, Vec3::Z, wo, mirror)
             .0
             .x
     };
