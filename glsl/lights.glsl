@@ -194,7 +194,8 @@ float environment_pdf(vec3 dir) {
 #endif
 }
 
-// A direction to the environment from u in [0, 1)^2 (by luminance for a map).
+// A direction to the environment from u in [0, 1)^2 (by luminance for a map). Twin:
+// Environment::sample_environment (src/scene/environment.rs) for a map.
 vec3 sample_environment(vec2 u) {
 #if SCENE_ENV_MAP
     uvec2 size = env_size();

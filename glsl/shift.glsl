@@ -316,10 +316,6 @@ bool finish_path(inout Path path) {
     return max_component(c) > 0.0;
 }
 
-bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
-    return trace_vertices(camera, x1, seed, target_length, nee_end, path) && finish_path(path);
-}
-
 struct Link {
     vec3 dir;
     vec3 f_cos;

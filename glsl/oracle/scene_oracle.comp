@@ -26,7 +26,7 @@ void main() {
     Hit h = trace_closest(o.xyz, d, o.w);
     bool occluded = trace_occluded(o.xyz, d, o.w);
     LightSample ls = sample_light(o.xyz, u);
-    uint offset_triangle = i % uint(triangles.length());
+    uint offset_triangle = i % uint(SCENE_TRIANGLES_LENGTH);
     bool shadowed = is_punctual_light(ls.triangle) && punctual_occluded(o.xyz, d, offset_triangle, ls.dir, ls.dist);
     outputs[6u * i + 5u] = vec4(shadowed ? 1.0 : 0.0, 0.0, 0.0, 0.0);
     outputs[6u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);

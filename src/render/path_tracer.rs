@@ -161,6 +161,18 @@ impl PathTracer {
         self.first_sample = first;
     }
 
+    /// Raises the render's target by `spp` paths per pixel and keeps the sums: the next `render`
+    /// continues the same sample sequence, so that its image averages all samples so far (the
+    /// image of one render of the total spp, up to float rounding of the sums).
+    pub fn add_samples(&mut self, spp: u32) {
+        self.settings.spp = self.settings.spp.saturating_add(spp);
+    }
+
+    /// The paths per pixel `render` runs up to.
+    pub fn target_spp(&self) -> u32 {
+        self.settings.spp
+    }
+
     /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the
     /// device has no timestamps), the most loop iterations any subgroup ran and the number of
     /// paths with a non-finite radiance or throughput.

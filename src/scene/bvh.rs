@@ -277,10 +277,11 @@ pub fn trace_occluded(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec
 /// Segment tests stop this fraction short of their (offset) end point.
 pub const SEGMENT_EPSILON: f32 = 1e-4;
 
-/// Twin of GLSL `segment_occluded`: whether anything blocks the segment between surface points
-/// p (normal np, on triangle index tp) and q (normal nq, on triangle index tq). Both ends are
-/// offset off their surfaces, each towards the other: offsetting one end only moves a grazing far
-/// hit by more than any epsilon.
+/// Whether anything blocks the segment between surface points p (normal np, on triangle index
+/// tp) and q (normal nq, on triangle index tq): the ray of `segment_ray`, traced (the kernels
+/// trace it inside `visibility_ray` of glsl/shift.glsl). Both ends are offset off their
+/// surfaces, each towards the other: offsetting one end only moves a grazing far hit by more
+/// than any epsilon.
 #[allow(clippy::too_many_arguments)]
 pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: Vec3, tp: u32, q: Vec3, nq: Vec3, tq: u32) -> bool {
     let (origin, dir) = segment_ray(triangles, p, np, tp, q, nq, tq);

@@ -130,14 +130,14 @@ impl EnvironmentMap {
     }
 
     /// (row, column) of the texel holding (u, v).
-    fn texel_of(&self, uv: Vec2) -> (usize, usize) {
+    fn env_texel_of(&self, uv: Vec2) -> (usize, usize) {
         let j = ((uv.x * self.width as f32) as usize).min(self.width as usize - 1);
         let i = ((uv.y * self.height as f32) as usize).min(self.height as usize - 1);
         (i, j)
     }
 
-    /// The probability of texel (i, j), from the CDFs that [`Self::sample`] inverts.
-    fn texel_probability(&self, i: usize, j: usize) -> f32 {
+    /// The probability of texel (i, j), from the CDFs that [`Self::sample_environment`] inverts.
+    fn env_texel_probability(&self, i: usize, j: usize) -> f32 {
         let w = self.width as usize;
         let row = self.row_cdf[i] - if i > 0 { self.row_cdf[i - 1] } else { 0.0 };
         let k = i * w + j;
@@ -145,13 +145,14 @@ impl EnvironmentMap {
         row * texel
     }
 
-    /// The radiance arriving from direction `d` (unit). Twin of GLSL `environment_radiance`.
+    /// The radiance arriving from direction `d` (unit): the map's part of
+    /// `lights::environment_radiance`, the twin of GLSL `environment_radiance`.
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        let (i, j) = self.texel_of(equirect_uv(d));
+        let (i, j) = self.env_texel_of(equirect_uv(d));
         self.texels[i * self.width as usize + j]
     }
 
-    /// The solid-angle density of [`Self::sample`] at direction `d` (unit): the texel's
+    /// The solid-angle density of [`Self::sample_environment`] at direction `d` (unit): the texel's
     /// probability times its (u, v) area's inverse, over the map's Jacobian 2π² sin θ.
     pub fn pdf(&self, d: Vec3) -> f32 {
         let uv = equirect_uv(d);
@@ -160,14 +161,14 @@ impl EnvironmentMap {
         if sin_theta <= 0.0 {
             return 0.0;
         }
-        let (i, j) = self.texel_of(uv);
-        let p_uv = self.texel_probability(i, j) * (self.width * self.height) as f32;
+        let (i, j) = self.env_texel_of(uv);
+        let p_uv = self.env_texel_probability(i, j) * (self.width * self.height) as f32;
         p_uv / (2.0 * PI * PI * sin_theta)
     }
 
     /// A direction chosen by luminance with `u` in [0, 1)²: a row by the marginal CDF, a texel
     /// by the row's CDF, then a uniform point of the texel (the CDF's leftover fractions).
-    pub fn sample(&self, u: Vec2) -> Vec3 {
+    pub fn sample_environment(&self, u: Vec2) -> Vec3 {
         let (w, h) = (self.width as usize, self.height as usize);
         let i = cdf_search(&self.row_cdf, u.x);
         let below = if i > 0 { self.row_cdf[i - 1] } else { 0.0 };

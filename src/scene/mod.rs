@@ -13,7 +13,7 @@ pub mod gltf_writer;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
-pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, LoadOptions, DEFAULT_ENVIRONMENT};
+pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, ArrayLimit, LoadOptions, DEFAULT_ENVIRONMENT};
 pub use gltf_material::spec_gloss_to_metal_rough;
 pub use gltf_mesh::triangle_indices;
 pub use punctual::{PunctualKind, PunctualLight};

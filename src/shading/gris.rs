@@ -7,6 +7,8 @@
 //! weighted by w_i = m_i(Y_i) p̂(Y_i) W_{X_i} |T_i'(X_i)|, and Y is chosen in proportion to w_i,
 //! with W_Y = sum_j w_j / p̂(Y).
 
+use glam::Vec3;
+
 /// How the resampling MIS weights m_i are computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mis {
@@ -122,4 +124,59 @@ pub fn resampled_expectation<S: Copy>(domains: &impl Domains<S>, inputs: &[Input
         .iter()
         .map(|&(y, w)| w * integrand(y) / domains.target(y))
         .sum()
+}
+
+/// Streaming weighted selection, candidate by candidate, as the kernels resample: after
+/// `resampler_offer` of candidates with weights w_i, candidate i is chosen with probability
+/// w_i / sum_j w_j, and `resampler_finish` gives W = sum_j w_j / p̂(chosen). `expected` is
+/// sum_i w_i f(y_i) / p̂(y_i), the expectation of f(Y) W_Y over the choice (see
+/// `resampled_expectation`), in RGB. Single precision, as on the GPU. Twin: `Resampler` and
+/// its functions in glsl/reservoir.glsl.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resampler<S> {
+    pub chosen: Option<S>,
+    pub chosen_target: f32,
+    pub weight_sum: f32,
+    /// The confidence M of the result: the sum of the inputs' confidence weights, which the
+    /// caller adds.
+    pub confidence: f32,
+    pub expected: Vec3,
+    /// The chosen candidate could not be recorded: the result is empty.
+    pub chosen_lost: bool,
+}
+
+pub fn resampler_begin<S>() -> Resampler<S> {
+    Resampler {
+        chosen: None,
+        chosen_target: 0.0,
+        weight_sum: 0.0,
+        confidence: 0.0,
+        expected: Vec3::ZERO,
+        chosen_lost: false,
+    }
+}
+
+/// Offers a candidate of contribution f (RGB) and target p̂ = `target` with weight `w` (finite,
+/// positive); true if it becomes the chosen one, which the caller then stores in `chosen`. `u`
+/// is uniform in [0, 1): the candidate replaces the chosen one when u < w / sum w.
+pub fn resampler_offer<S>(s: &mut Resampler<S>, contribution: Vec3, target: f32, w: f32, u: f32) -> bool {
+    s.weight_sum += w;
+    s.expected += (w / target) * contribution;
+    if u * s.weight_sum >= w {
+        return false;
+    }
+    s.chosen_target = target;
+    s.chosen_lost = false;
+    true
+}
+
+/// The chosen sample, its unbiased contribution weight W (0 if nothing was chosen or the choice
+/// was lost) and the confidence M.
+pub fn resampler_finish<S: Copy>(s: &Resampler<S>) -> (Option<S>, f32, f32) {
+    let w = if s.weight_sum > 0.0 && !s.chosen_lost {
+        s.weight_sum / s.chosen_target
+    } else {
+        0.0
+    };
+    (s.chosen, w, s.confidence)
 }

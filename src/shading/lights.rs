@@ -179,7 +179,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
     let p_env = scene.env_select_prob;
     if u.x < p_env {
         let dir = match &scene.environment_map {
-            Some(map) => map.sample(Vec2::new(u.y, u.z)),
+            Some(map) => map.sample_environment(Vec2::new(u.y, u.z)),
             None => sample_uniform_sphere(Vec2::new(u.y, u.z)),
         };
         return LightSample {

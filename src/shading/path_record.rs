@@ -46,29 +46,8 @@ pub struct PathRecord {
 }
 
 impl PathRecord {
-    pub fn length(&self) -> usize {
-        (self.info & INFO_LENGTH_MASK) as usize
-    }
-
-    /// The reconnection index r (1-based: x_r is the r-th vertex after the camera).
-    pub fn reconnection_index(&self) -> Option<usize> {
-        match (self.info >> INFO_RC_SHIFT) & 0xf {
-            0 => None,
-            r => Some(r as usize),
-        }
-    }
-
-    pub fn nee_end(&self) -> bool {
-        self.info & INFO_NEE_END != 0
-    }
-
     pub fn pack_info(length: usize, reconnection: Option<usize>, nee_end: bool) -> u32 {
         length as u32 | (reconnection.unwrap_or(0) as u32) << INFO_RC_SHIFT | if nee_end { INFO_NEE_END } else { 0 }
-    }
-
-    /// The lobe sampled at x_i (1-based).
-    pub fn lobe(&self, i: usize) -> u32 {
-        (self.lobes >> (LOBE_BITS * (i as u32 - 1))) & ((1 << LOBE_BITS) - 1)
     }
 
     pub fn pack_lobes(lobes: &[u32]) -> u32 {
@@ -78,4 +57,27 @@ impl PathRecord {
     pub fn contribution(&self) -> Vec3 {
         Vec3::from(self.contribution)
     }
+}
+
+/// The path's length k (its vertices x1..xk).
+pub fn record_length(r: &PathRecord) -> usize {
+    (r.info & INFO_LENGTH_MASK) as usize
+}
+
+/// The reconnection index r (1-based: x_r is the r-th vertex after the camera).
+pub fn record_reconnection_index(r: &PathRecord) -> Option<usize> {
+    match (r.info >> INFO_RC_SHIFT) & 0xf {
+        0 => None,
+        i => Some(i as usize),
+    }
+}
+
+/// Whether NEE chose the path's last vertex.
+pub fn record_nee_end(r: &PathRecord) -> bool {
+    r.info & INFO_NEE_END != 0
+}
+
+/// The lobe sampled at x_i (1-based).
+pub fn record_lobe(r: &PathRecord, i: usize) -> u32 {
+    (r.lobes >> (LOBE_BITS * (i as u32 - 1))) & ((1 << LOBE_BITS) - 1)
 }

@@ -34,7 +34,7 @@ use crate::shading::lights::{
     emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
     punctual_pdf, sample_light,
 };
-use crate::shading::path_record::{PathRecord, MAX_PATH_LENGTH};
+use crate::shading::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord, MAX_PATH_LENGTH};
 use crate::shading::ray_offset::offset_ray_origin;
 use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::shading::sampling::balance_heuristic;
@@ -68,51 +68,52 @@ pub struct Vertex {
     pub triangle: u32,
 }
 
-impl Vertex {
-    pub fn is_escaped(&self) -> bool {
-        self.triangle == NO_HIT
-    }
+/// Whether `v` is a direction to the environment.
+pub fn vertex_is_escaped(v: &Vertex) -> bool {
+    v.triangle == NO_HIT
+}
 
-    /// On punctual light `triangle & !PUNCTUAL_LIGHT_BIT` (only as a path's last vertex).
-    pub fn is_punctual(&self) -> bool {
-        is_punctual_light(self.triangle)
-    }
+/// Whether `v` is on punctual light `triangle & !PUNCTUAL_LIGHT_BIT` (only as a path's last
+/// vertex).
+pub fn vertex_is_punctual(v: &Vertex) -> bool {
+    is_punctual_light(v.triangle)
+}
 
-    fn light(&self) -> u32 {
-        self.triangle & !PUNCTUAL_LIGHT_BIT
-    }
+fn vertex_light(v: &Vertex) -> u32 {
+    v.triangle & !PUNCTUAL_LIGHT_BIT
+}
 
-    /// Escaped, or on a directional light: `pos` is a direction, the vertex infinitely far.
-    pub fn is_at_infinity(&self, scene: &Scene) -> bool {
-        self.is_escaped() || (self.is_punctual() && scene.lights[self.light() as usize].kind == PunctualKind::Directional)
-    }
+/// Escaped, or on a directional light: `pos` is a direction, the vertex infinitely far.
+pub fn vertex_is_at_infinity(scene: &Scene, v: &Vertex) -> bool {
+    vertex_is_escaped(v) || (vertex_is_punctual(v) && scene.lights[vertex_light(v) as usize].kind == PunctualKind::Directional)
+}
 
-    /// Punctual light `id` as a vertex: its position, or the direction towards a directional one.
-    pub fn punctual(scene: &Scene, id: u32) -> Vertex {
-        let l = &scene.lights[(id & !PUNCTUAL_LIGHT_BIT) as usize];
-        let pos = if l.kind == PunctualKind::Directional {
-            -l.direction
-        } else {
-            l.position
-        };
-        Vertex {
-            pos,
-            normal: Vec3::ZERO,
-            triangle: id,
-        }
+/// Punctual light `id` as a vertex: its position, or the direction towards a directional one.
+pub fn vertex_punctual(scene: &Scene, id: u32) -> Vertex {
+    let l = &scene.lights[(id & !PUNCTUAL_LIGHT_BIT) as usize];
+    let pos = if l.kind == PunctualKind::Directional {
+        -l.direction
+    } else {
+        l.position
+    };
+    Vertex {
+        pos,
+        normal: Vec3::ZERO,
+        triangle: id,
     }
+}
 
-    pub fn on_surface(scene: &Scene, triangle: u32, pos: Vec3) -> Vertex {
-        let normal = scene.triangles[triangle as usize].normal_area2().normalize();
-        Vertex { pos, normal, triangle }
-    }
+/// The point `pos` on `triangle`, with the triangle's geometric normal.
+pub fn vertex_on_surface(scene: &Scene, triangle: u32, pos: Vec3) -> Vertex {
+    let normal = scene.triangles[triangle as usize].normal_area2().normalize();
+    Vertex { pos, normal, triangle }
+}
 
-    fn escaped(dir: Vec3) -> Vertex {
-        Vertex {
-            pos: dir,
-            normal: Vec3::ZERO,
-            triangle: NO_HIT,
-        }
+fn vertex_escaped(dir: Vec3) -> Vertex {
+    Vertex {
+        pos: dir,
+        normal: Vec3::ZERO,
+        triangle: NO_HIT,
     }
 }
 
@@ -156,32 +157,31 @@ pub struct ShiftResult {
     pub reconnection: Option<ReconnectionTerms>,
 }
 
-impl ShiftResult {
-    fn failed() -> ShiftResult {
-        ShiftResult {
-            valid: false,
-            record: PathRecord::default(),
-            jacobian: 0.0,
-            contribution: Vec3::ZERO,
-            vertices: vec![],
-            reconnection: None,
-        }
+fn shift_failed() -> ShiftResult {
+    ShiftResult {
+        valid: false,
+        record: PathRecord::default(),
+        jacobian: 0.0,
+        contribution: Vec3::ZERO,
+        vertices: vec![],
+        reconnection: None,
     }
+}
 
-    fn ok(record: PathRecord, jacobian: f32, vertices: Vec<Vertex>) -> ShiftResult {
-        let contribution = record.contribution();
-        // A non-finite or non-positive Jacobian counts as a failed shift, never as a value.
-        if !jacobian.is_finite() || jacobian <= 0.0 || !contribution.is_finite() {
-            return ShiftResult::failed();
-        }
-        ShiftResult {
-            valid: true,
-            record,
-            jacobian,
-            contribution,
-            vertices,
-            reconnection: None,
-        }
+/// A valid shift; a non-finite or non-positive Jacobian counts as a failed shift, never as a
+/// value.
+fn shift_ok(record: PathRecord, jacobian: f32, vertices: Vec<Vertex>) -> ShiftResult {
+    let contribution = record.contribution();
+    if !jacobian.is_finite() || jacobian <= 0.0 || !contribution.is_finite() {
+        return shift_failed();
+    }
+    ShiftResult {
+        valid: true,
+        record,
+        jacobian,
+        contribution,
+        vertices,
+        reconnection: None,
     }
 }
 
@@ -189,7 +189,7 @@ impl ShiftResult {
 /// (diffuse, or GGX, including a non-metal's specular layer, at least as rough as the threshold).
 /// Escaped directions count as rough.
 pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool {
-    if v.is_escaped() || v.is_punctual() {
+    if vertex_is_escaped(v) || vertex_is_punctual(v) {
         return true;
     }
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
@@ -202,8 +202,8 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
 
 /// The reconnection test for the pair (prev, cur): both rough and far enough apart.
 pub fn is_reconnectable(scene: &Scene, prev: &Vertex, cur: &Vertex, params: &ShiftParams) -> bool {
-    let far = cur.is_at_infinity(scene) || prev.pos.distance(cur.pos) >= params.distance_threshold;
-    !prev.is_escaped() && far && vertex_is_rough(scene, prev, params) && vertex_is_rough(scene, cur, params)
+    let far = vertex_is_at_infinity(scene, cur) || prev.pos.distance(cur.pos) >= params.distance_threshold;
+    !vertex_is_escaped(prev) && far && vertex_is_rough(scene, prev, params) && vertex_is_rough(scene, cur, params)
 }
 
 /// The first index r >= 2 (1-based, x_r = vertices[r - 1]) whose pair (x_{r-1}, x_r) passes the
@@ -218,7 +218,7 @@ fn material_of(scene: &Scene, v: &Vertex) -> crate::gpu_types::Material {
 
 /// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
 fn direction(scene: &Scene, from: &Vertex, to: &Vertex) -> (Vec3, f32) {
-    if to.is_at_infinity(scene) {
+    if vertex_is_at_infinity(scene, to) {
         (to.pos, f32::INFINITY)
     } else {
         let d = to.pos - from.pos;
@@ -228,11 +228,11 @@ fn direction(scene: &Scene, from: &Vertex, to: &Vertex) -> (Vec3, f32) {
 }
 
 fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
-    if to.is_punctual() {
+    if vertex_is_punctual(to) {
         let (dir, dist) = direction(scene, from, to);
         return !punctual_occluded(scene, from.pos, from.normal, from.triangle, dir, dist);
     }
-    if !to.is_escaped() {
+    if !vertex_is_escaped(to) {
         return !segment_occluded(
             &scene.nodes,
             &scene.triangles,
@@ -251,11 +251,11 @@ fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
 
 /// Radiance emitted by the end vertex `end` towards `from`.
 fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
-    if end.is_escaped() {
+    if vertex_is_escaped(end) {
         return environment_radiance(scene, end.pos);
     }
-    if end.is_punctual() {
-        return punctual_arrival(&scene.lights[end.light() as usize], from.pos).2;
+    if vertex_is_punctual(end) {
+        return punctual_arrival(&scene.lights[vertex_light(end) as usize], from.pos).2;
     }
     let tri = &scene.triangles[end.triangle as usize];
     if tri.emitter == NO_EMITTER {
@@ -267,11 +267,11 @@ fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
 /// Solid-angle pdf that NEE at `from` picks `end`; for a punctual light the discrete probability
 /// of choosing it.
 fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
-    if end.is_punctual() {
-        return punctual_pdf(scene, end.light());
+    if vertex_is_punctual(end) {
+        return punctual_pdf(scene, vertex_light(end));
     }
     let (dir, dist) = direction(scene, from, end);
-    if end.is_escaped() {
+    if vertex_is_escaped(end) {
         environment_pdf(scene, dir)
     } else {
         emitter_pdf(scene, end.triangle, dir, dist)
@@ -283,7 +283,7 @@ fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
 /// path gets its own weight. After a delta lobe only BSDF sampling reaches the end: weight 1.
 pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee_end: bool, after_delta: bool) -> f32 {
     // NEE alone reaches a punctual light.
-    if end.is_punctual() {
+    if vertex_is_punctual(end) {
         return if nee_end { 1.0 } else { 0.0 };
     }
     if after_delta {
@@ -305,17 +305,30 @@ pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee
 /// occluded light sample) or its end emits nothing towards it.
 pub fn generate_path(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: usize, nee_end: bool) -> Option<Path> {
     let mut path = trace_vertices(scene, camera, x1, seed, length, nee_end)?;
+    finish_path(scene, &mut path).then_some(path)
+}
+
+/// The end weight and contribution of a path whose vertices `trace_vertices` made; false if it
+/// carries no light.
+fn finish_path(scene: &Scene, path: &mut Path) -> bool {
     let k = path.length();
     let emitted = if k >= 2 {
-        let before = if k >= 3 { path.vertices[k - 3].pos } else { camera };
+        let before = if k >= 3 { path.vertices[k - 3].pos } else { path.camera };
         let after_delta = path.lobes[k - 2] & LOBE_DELTA != 0;
-        path.end_weight = end_mis_weight(scene, &path.vertices[k - 2], before, &path.vertices[k - 1], nee_end, after_delta);
+        path.end_weight = end_mis_weight(
+            scene,
+            &path.vertices[k - 2],
+            before,
+            &path.vertices[k - 1],
+            path.nee_end,
+            after_delta,
+        );
         end_emission(scene, &path.vertices[k - 2], &path.vertices[k - 1]) * path.end_weight
     } else {
         Vec3::ZERO
     };
     path.contribution = path.weights.iter().fold(emitted, |acc, &w| acc * w);
-    (path.contribution.max_element() > 0.0).then_some(path)
+    path.contribution.max_element() > 0.0
 }
 
 /// The vertices, lobes and weights of `generate_path`, without the emission at the end.
@@ -334,7 +347,7 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
     while path.length() < length {
         let i = path.length();
         let x = *path.vertices.last().expect("x1 is present");
-        if x.is_escaped() {
+        if vertex_is_escaped(&x) {
             return None;
         }
         let wo = (prev_pos - x.pos).normalize();
@@ -345,11 +358,11 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
                 return None;
             }
             let end = if is_punctual_light(ls.triangle) {
-                Vertex::punctual(scene, ls.triangle)
+                vertex_punctual(scene, ls.triangle)
             } else if ls.triangle == NO_EMITTER {
-                Vertex::escaped(ls.dir)
+                vertex_escaped(ls.dir)
             } else {
-                Vertex::on_surface(scene, ls.triangle, x.pos + ls.dir * ls.dist)
+                vertex_on_surface(scene, ls.triangle, x.pos + ls.dir * ls.dist)
             };
             if !visible(scene, &x, &end) {
                 return None;
@@ -369,7 +382,7 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
                 1e30,
             );
             let next = if hit.triangle == NO_HIT {
-                Vertex::escaped(s.wi)
+                vertex_escaped(s.wi)
             } else {
                 hit_vertex(scene, hit)
             };
@@ -385,7 +398,7 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
 
 fn hit_vertex(scene: &Scene, hit: crate::scene::bvh::Hit) -> Vertex {
     let t = &scene.triangles[hit.triangle as usize];
-    Vertex::on_surface(
+    vertex_on_surface(
         scene,
         hit.triangle,
         Vec3::from(t.v0) + hit.bary.x * Vec3::from(t.e1) + hit.bary.y * Vec3::from(t.e2),
@@ -464,8 +477,8 @@ fn join_at_reconnection(
     x_r: &Vertex,
     prefix_weight: Vec3,
 ) -> Option<Joined> {
-    let (k, r) = (base.length(), base.reconnection_index()?);
-    let link = reconnection_link(scene, prev, before, x_r, r == k && base.nee_end());
+    let (k, r) = (record_length(base), record_reconnection_index(base)?);
+    let link = reconnection_link(scene, prev, before, x_r, r == k && record_nee_end(base));
     if !(link.pdf > 0.0) || link.f_cos.max_element() <= 0.0 {
         return None;
     }
@@ -478,14 +491,14 @@ fn join_at_reconnection(
     let weight = prefix_weight * link.f_cos / link.pdf;
     let mut pdf_after_x_r = None;
     let contribution = if r == k {
-        let after_delta = base.lobe(k - 1) & LOBE_DELTA != 0;
-        weight * end_emission(scene, prev, x_r) * end_mis_weight(scene, prev, before, x_r, base.nee_end(), after_delta)
+        let after_delta = record_lobe(base, k - 1) & LOBE_DELTA != 0;
+        weight * end_emission(scene, prev, x_r) * end_mis_weight(scene, prev, before, x_r, record_nee_end(base), after_delta)
     } else {
         // x_r scatters towards x_{r+1} with this predecessor's incoming direction.
         let x_next = record_vertex(scene, base.rc_next_triangle, base.rc_next);
-        let next_is_nee = r + 1 == k && base.nee_end();
+        let next_is_nee = r + 1 == k && record_nee_end(base);
         let (f_r, q) = pdf_after(scene, x_r, link.dir, &x_next, next_is_nee);
-        if !(q > 0.0) || f_r.max_element() <= 0.0 || base.lobe(r) & LOBE_DELTA != 0 {
+        if !(q > 0.0) || f_r.max_element() <= 0.0 || record_lobe(base, r) & LOBE_DELTA != 0 {
             return None;
         }
         if !next_is_nee {
@@ -493,7 +506,7 @@ fn join_at_reconnection(
             pdf_after_x_r = Some(q);
         }
         let end_weight = if r + 1 == k {
-            end_mis_weight(scene, x_r, prev.pos, &x_next, base.nee_end(), false)
+            end_mis_weight(scene, x_r, prev.pos, &x_next, record_nee_end(base), false)
         } else {
             1.0
         };
@@ -529,7 +542,7 @@ fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, n
     );
     let pdf = if nee_at_r { light_pdf(scene, prev, x_r) } else { bsdf_pdf };
     // A punctual x_r is one fixed point or direction whatever joins it: no area factor.
-    let geometry = if x_r.is_escaped() || x_r.is_punctual() {
+    let geometry = if vertex_is_escaped(x_r) || vertex_is_punctual(x_r) {
         1.0
     } else {
         x_r.normal.dot(dir).abs() / (dist * dist)
@@ -547,21 +560,21 @@ fn pdf_after(scene: &Scene, x_r: &Vertex, dir_in: Vec3, next: &Vertex, next_is_n
 
 fn record_vertex(scene: &Scene, triangle: u32, pos: [f32; 3]) -> Vertex {
     if is_punctual_light(triangle) {
-        Vertex::punctual(scene, triangle)
+        vertex_punctual(scene, triangle)
     } else if triangle == NO_HIT {
-        Vertex::escaped(Vec3::from(pos))
+        vertex_escaped(Vec3::from(pos))
     } else {
-        Vertex::on_surface(scene, triangle, Vec3::from(pos))
+        vertex_on_surface(scene, triangle, Vec3::from(pos))
     }
 }
 
 /// Random replay: regenerate the record's random numbers from the target's primary hit. Valid
 /// only with the same length, end type and lobes at every vertex; Jacobian 1.
 pub fn shift_random_replay(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
-    let replayed = generate_path(scene, camera, y1, base.seed, base.length(), base.nee_end());
+    let replayed = generate_path(scene, camera, y1, base.seed, record_length(base), record_nee_end(base));
     match replayed.as_ref().and_then(|y| Some((y, record_path(scene, params, y)?))) {
-        Some((y, record)) if record.lobes == base.lobes => ShiftResult::ok(record, 1.0, y.vertices.clone()),
-        _ => ShiftResult::failed(),
+        Some((y, record)) if record.lobes == base.lobes => shift_ok(record, 1.0, y.vertices.clone()),
+        _ => shift_failed(),
     }
 }
 
@@ -574,13 +587,13 @@ pub fn inverse_random_replay(scene: &Scene, params: &ShiftParams, shifted: &Path
 /// and keep the suffix. Without a reconnection index it is random replay; it fails where the
 /// replayed prefix would reconnect earlier than r, so that its inverse is defined.
 pub fn shift_hybrid(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
-    match base.reconnection_index() {
+    match record_reconnection_index(base) {
         None => {
             let replay = shift_random_replay(scene, params, base, camera, y1);
-            if replay.valid && replay.record.reconnection_index().is_none() {
+            if replay.valid && record_reconnection_index(&replay.record).is_none() {
                 replay
             } else {
-                ShiftResult::failed()
+                shift_failed()
             }
         }
         Some(r) => reconnect_at(scene, params, base, camera, y1, r),
@@ -596,9 +609,9 @@ pub fn inverse_hybrid(scene: &Scene, params: &ShiftParams, shifted: &PathRecord,
 /// Reconnection shift: y0, y1 of the target, then x2..xk of the base. Valid only if the base
 /// reconnects at r = 2 (x1 and x2 rough, far enough apart) and so does the shifted path.
 pub fn shift_reconnection(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
-    match base.reconnection_index() {
+    match record_reconnection_index(base) {
         Some(2) => reconnect_at(scene, params, base, camera, y1, 2),
-        _ => ShiftResult::failed(),
+        _ => shift_failed(),
     }
 }
 
@@ -611,27 +624,27 @@ pub fn inverse_reconnection(scene: &Scene, params: &ShiftParams, shifted: &PathR
 fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex, r: usize) -> ShiftResult {
     // The replayed prefix y1..y_{r-1}: BSDF sampling only, whatever the base's end type.
     let Some(prefix) = trace_vertices(scene, camera, y1, base.seed, r - 1, false) else {
-        return ShiftResult::failed();
+        return shift_failed();
     };
-    if (1..r - 1).any(|i| prefix.lobes[i - 1] != base.lobe(i)) {
-        return ShiftResult::failed();
+    if (1..r - 1).any(|i| prefix.lobes[i - 1] != record_lobe(base, i)) {
+        return shift_failed();
     }
     // Invertibility: the shifted path must first become reconnectable at r, not earlier.
     if (2..r).any(|i| is_reconnectable(scene, &prefix.vertices[i - 2], &prefix.vertices[i - 1], params)) {
-        return ShiftResult::failed();
+        return shift_failed();
     }
     let y_prev = prefix.vertices[r - 2];
     let x_r = record_vertex(scene, base.rc_triangle, base.rc_pos);
     if !is_reconnectable(scene, &y_prev, &x_r, params) || !visible(scene, &y_prev, &x_r) {
-        return ShiftResult::failed();
+        return shift_failed();
     }
     let y_before = if r >= 3 { prefix.vertices[r - 3].pos } else { camera };
     let prefix_weight = prefix.weights.iter().product();
     let Some(joined) = join_at_reconnection(scene, base, &y_prev, y_before, &x_r, prefix_weight) else {
-        return ShiftResult::failed();
+        return shift_failed();
     };
     if !(base.rc_pdf > 0.0 && base.rc_pdf_after > 0.0) {
-        return ShiftResult::failed();
+        return shift_failed();
     }
     let terms = ReconnectionTerms {
         geometry_y: joined.record.rc_geometry,
@@ -641,7 +654,7 @@ fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: 
         pdf_after_y: joined.pdf_after.unwrap_or(1.0),
         pdf_after_x: joined.pdf_after.map_or(1.0, |_| base.rc_pdf_after),
     };
-    let mut result = ShiftResult::ok(joined.record, terms.jacobian(), prefix.vertices);
+    let mut result = shift_ok(joined.record, terms.jacobian(), prefix.vertices);
     if result.valid {
         result.reconnection = Some(terms);
     }

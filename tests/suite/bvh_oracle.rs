@@ -11,7 +11,7 @@ use restir_pt::shading::lights::sample_light;
 use restir_pt::shading::ray_offset::offset_ray_origin;
 use restir_pt::vk::{Buffer, BufferUsage};
 
-use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, close, gpu, run_oracle_with_defines, TestRng};
 
 const RAYS: usize = 20_000;
 
@@ -120,23 +120,45 @@ fn random_scene_full(
 #[test]
 fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
     let ctx = gpu();
-    // Punctual lights share the alias table: light sampling's delta branch is compared too.
     let scene = random_scene_with_punctual_lights(1);
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(
+        !scene_gpu.uniform && !scene_gpu.addressed(),
+        "this scene is meant to exercise the storage-buffer path"
+    );
+    check_scene_oracle(&ctx, &scene, &scene_gpu, &[]);
+}
+
+/// The same comparison with the scene's triangles, BVH nodes and emitters reached by device
+/// address (SCENE_ADDRESSED), as scenes past one binding's range are: a 4 KiB binding limit
+/// sends this 6000-triangle scene down that path.
+#[test]
+fn bvh_traversal_lights_and_camera_glsl_matches_rust_addressed() {
+    let ctx = crate::common::gpu_with_scene_binding_limit(Some(4096));
+    assert!(ctx.info.buffer_device_address, "the device lacks bufferDeviceAddress");
+    let scene = random_scene_with_punctual_lights(1);
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(scene_gpu.addressed() && !scene_gpu.uniform);
+    check_scene_oracle(&ctx, &scene, &scene_gpu, &[("SCENE_ADDRESSED", "1")]);
+}
+
+/// Runs oracle/scene_oracle.comp (compiled with `defines`) over random rays and compares every
+/// output with the Rust twins.
+fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene, scene_gpu: &SceneGpu, defines: &[(&str, &str)]) {
+    // Punctual lights share the alias table: light sampling's delta branch is compared too.
     let settings = RenderSettings {
         width: 64,
         height: 48,
         ..Default::default()
     };
-    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-    assert!(!scene_gpu.uniform, "this scene is meant to exercise the storage-buffer path");
     let params = Buffer::new(
-        &ctx,
+        ctx,
         "params",
         std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(&scene)]).unwrap();
+    params.write(&[settings.frame_params(scene)]).unwrap();
 
     let mut r = TestRng(2);
     let mut inputs = Vec::with_capacity(4 * RAYS);
@@ -149,9 +171,10 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
         inputs.push(Vec4::new(r.uniform() * 64.0, r.uniform() * 48.0, 0.0, 0.0));
     }
-    let out: Vec<Vec4> = run_oracle(
-        &ctx,
+    let out: Vec<Vec4> = run_oracle_with_defines(
+        ctx,
         "oracle/scene_oracle.comp",
+        defines,
         &scene_gpu.buffers(&params),
         &[bytemuck::cast_slice(&inputs)],
         RAYS * 24,
@@ -192,7 +215,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         for k in 0..3 {
             assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
         }
-        let ls = sample_light(&scene, o.truncate(), u);
+        let ls = sample_light(scene, o.truncate(), u);
         let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
         assert!(
             dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
@@ -208,7 +231,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
             punctual_samples += 1;
             let shadowed =
-                restir_pt::shading::lights::punctual_occluded(&scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+                restir_pt::shading::lights::punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
             assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
             punctual_shadowed += shadowed as usize;
         }
@@ -225,7 +248,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         hits > RAYS / 4,
         "only {hits} of {RAYS} rays hit: the scene does not exercise traversal"
     );
-    assert_clean(&ctx);
+    assert_clean(ctx);
 }
 
 #[test]

@@ -235,7 +235,7 @@ fn environment_map_sampling_chi_square_and_pdf() {
     let mut observed = vec![0.0; w * h];
     let mut r = TestRng(91);
     for _ in 0..SAMPLES {
-        let d = map.sample(Vec2::new(r.uniform(), r.uniform()));
+        let d = map.sample_environment(Vec2::new(r.uniform(), r.uniform()));
         assert!((d.length() - 1.0).abs() < 1e-4);
         let uv = equirect_uv(d);
         let (i, j) = (((uv.y * h as f32) as usize).min(h - 1), ((uv.x * w as f32) as usize).min(w - 1));
