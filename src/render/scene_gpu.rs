@@ -14,13 +14,8 @@ use ash::vk::PhysicalDeviceType;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
-<<<<<<< HEAD
 use crate::shading::bsdf::{has_specular_layer, lobe_weights};
-use crate::vk::{Binding, Buffer, Context};
-=======
-use crate::shading::bsdf::lobe_weights;
 use crate::vk::{Binding, Buffer, BufferUsage, Context};
->>>>>>> main
 
 pub struct SceneGpu {
     pub triangles: Buffer,
