@@ -27,7 +27,9 @@ use crate::gpu_types::{Material, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::scene::PunctualKind;
 use crate::scene::Scene;
-use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, has_specular_layer, index_matched, lobe_weights, BsdfSample, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::shading::bsdf::{
+    bsdf_eval_pdf, bsdf_sample, has_specular_layer, index_matched, lobe_weights, BsdfSample, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE,
+};
 use crate::shading::lights::{
     emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
     punctual_pdf, sample_light, LightSample,

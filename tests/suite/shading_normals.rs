@@ -51,7 +51,10 @@ fn shading_normal_tilted_plane_matches_closed_form_glsl_and_rust() {
         &ctx,
         "oracle/bsdf_oracle.comp",
         &[],
-        &[("Materials", bytemuck::cast_slice(&materials)), ("Inputs", bytemuck::cast_slice(&inputs))],
+        &[
+            ("Materials", bytemuck::cast_slice(&materials)),
+            ("Inputs", bytemuck::cast_slice(&inputs)),
+        ],
         materials.len() * 12,
         materials.len() as u32,
     );

@@ -83,7 +83,10 @@ fn specular_layer_furnace_never_gains_energy_glsl_and_rust() {
         &ctx,
         "oracle/bsdf_oracle.comp",
         &[],
-        &[("Materials", bytemuck::cast_slice(&materials)), ("Inputs", bytemuck::cast_slice(&inputs))],
+        &[
+            ("Materials", bytemuck::cast_slice(&materials)),
+            ("Inputs", bytemuck::cast_slice(&inputs)),
+        ],
         items * 12,
         items as u32,
     );
