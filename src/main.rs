@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use restir_pt::cli::{self, DeviceArgs, Method, RenderArgs};
 use restir_pt::image_io::Exposure;
-use restir_pt::render::{RestirSettings, ReuseMis, ShiftKind};
+use restir_pt::render::{History, RestirSettings, ReuseMis, ShiftKind};
 use restir_pt::scene::LoadOptions;
 
 #[derive(Parser)]
@@ -67,6 +67,21 @@ enum MethodOpt {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum HistoryOpt {
+    Temporal,
+    Spatial,
+}
+
+impl From<History> for HistoryOpt {
+    fn from(h: History) -> Self {
+        match h {
+            History::Temporal => HistoryOpt::Temporal,
+            History::Spatial => HistoryOpt::Spatial,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum ShiftOpt {
     Reconnection,
     Replay,
@@ -102,6 +117,10 @@ struct RestirOpts {
     /// ReSTIR PT: the shift mapping used for reuse.
     #[arg(long, value_enum, default_value_t = ShiftOpt::Hybrid)]
     shift: ShiftOpt,
+    /// ReSTIR PT: the reservoirs the next frame's temporal reuse reads, those before spatial
+    /// reuse (temporal) or after it (spatial).
+    #[arg(long, value_enum, default_value_t = HistoryOpt::from(RestirSettings::default().history))]
+    history: HistoryOpt,
     /// ReSTIR PT: resampling MIS weights.
     #[arg(long, value_enum, default_value_t = MisOpt::Gbh)]
     mis: MisOpt,
@@ -147,6 +166,10 @@ impl RestirOpts {
                 MisOpt::Pairwise => ReuseMis::Pairwise,
             },
             temporal: self.temporal.on(),
+            history: match self.history {
+                HistoryOpt::Temporal => History::Temporal,
+                HistoryOpt::Spatial => History::Spatial,
+            },
             spatial: self.spatial,
             radius: self.radius,
             rounds: self.rounds,

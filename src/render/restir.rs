@@ -278,6 +278,7 @@ impl Restir {
             unmoved: same_pose(&prev, &frame_params),
             surface_slot: self.surface_slot,
             spatial_rounds: self.restir.spatial_rounds(),
+            history: self.restir.history,
         });
         self.params.write(std::slice::from_ref(&frame_params))?;
         let reuse = self.reuse_params(&prev, &frame_params, &plan, accumulate);
