@@ -58,13 +58,12 @@ pub struct FrameState {
 }
 
 /// The reservoirs a frame leaves as the next frame's history.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum History {
     /// The reservoirs before spatial reuse (the initial or temporal pass's output), as ReSTIR GI
     /// keeps its temporal and spatial reservoirs apart (Ouyang et al. 2021): a path that spatial
     /// reuse copies into a neighbour is not carried on in the neighbour's history, so a rare
     /// bright path does not spread from pixel to pixel frame after frame.
-    #[default]
     Temporal,
     /// The reservoirs after the last spatial round (Bitterli et al. 2020; Lin et al. 2022).
     Spatial,
