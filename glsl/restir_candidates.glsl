@@ -4,11 +4,13 @@
 // (end_mis_weight in shift.glsl): the two weighted integrands sum to the path's, and each is a
 // function of the path that the shifts evaluate anew (the end type travels in the record). The
 // paths are built with the steps trace_vertices() in shift.glsl regenerates them with
-// (nee_vertex, bsdf_vertex).
+// (nee_vertex, bsdf_vertex). Expects the scene bindings and the pass counters
+// local_nonfinite_weights and local_candidates_dropped (restir_bindings.glsl; an oracle kernel
+// declares its own). Twin: src/shading/candidates.rs.
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
 
-#include "restir_bindings.glsl"
+#include "reservoir.glsl"
 #include "shift.glsl"
 
 // A candidate of the path being traced, described against that path: its first `count`

@@ -131,9 +131,7 @@ pub struct FrameParams {
     pub emitter_count: u32,
 }
 
-/// The most passes a ReSTIR PT frame runs (RESTIR_MAX_PASSES in glsl/restir_bindings.glsl):
-/// initial, temporal, 3 spatial rounds and shading.
-pub const RESTIR_MAX_PASSES: usize = 6;
+pub use crate::shader_interface::RESTIR_MAX_PASSES;
 
 /// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: the frame's reuse
 /// parameters and its pass table.

@@ -173,7 +173,8 @@ impl SceneArgs {
         scene_path(self.scene.as_deref())
     }
 
-    /// What to load besides the file; `array_limit` is the device's limit on one scene array.
+    /// What to load besides the file; `array_limit` is the device's limit on one scene array
+    /// (`Context::scene_array_limit`), None before a device is open.
     pub fn load_options(&self, array_limit: Option<ArrayLimit>) -> LoadOptions {
         LoadOptions {
             scene: self.scene_index,
@@ -295,17 +296,35 @@ pub fn parse_env(s: &str) -> Result<EnvArg, String> {
     parse_radiance(s).map(EnvArg::Constant)
 }
 
+/// R,G,B radiances; each error names the value and its first problem (negative values included:
+/// the option takes hyphen values so that `--env -1,0,0` reaches this check, not clap's).
 fn parse_radiance(s: &str) -> Result<Vec3, String> {
-    let usage = || format!("{s:?} must be R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr");
-    let values: Vec<f32> = s
-        .split(',')
-        .map(|v| v.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| usage())?;
-    match values[..] {
-        [r, g, b] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok(Vec3::new(r, g, b)),
-        _ => Err(usage()),
+    const USAGE: &str = "--env takes R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr";
+    if s.trim().is_empty() {
+        return Err(format!("the value is empty; {USAGE}"));
     }
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        let looks_like_file = s.contains('/')
+            || s.rsplit_once('.')
+                .is_some_and(|(_, ext)| ext.chars().any(|c| c.is_ascii_alphabetic()));
+        return Err(if looks_like_file {
+            format!("{s:?}: environment maps are read from .exr or .hdr files; {USAGE}")
+        } else {
+            format!("{s:?} has {} value(s); {USAGE}", parts.len())
+        });
+    }
+    let mut rgb = [0.0f32; 3];
+    for (value, part) in rgb.iter_mut().zip(&parts) {
+        *value = part.parse().map_err(|_| format!("{s:?}: {part:?} is not a number; {USAGE}"))?;
+        if !value.is_finite() {
+            return Err(format!("{s:?}: {part} is not a finite f32 radiance; {USAGE}"));
+        }
+        if *value < 0.0 {
+            return Err(format!("{s:?}: {part} is negative; {USAGE}"));
+        }
+    }
+    Ok(Vec3::from_array(rgb))
 }
 
 #[cfg(test)]

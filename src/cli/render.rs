@@ -115,7 +115,7 @@ impl RenderArgs {
             MethodArg::Pt => {
                 let ignored = self.restir.changed_flags();
                 if !ignored.is_empty() {
-                    eprintln!("warning: {} set ReSTIR PT and are ignored by --method pt", ignored.join(", "));
+                    eprintln!("warning: --method pt ignores the ReSTIR PT options {}", ignored.join(", "));
                 }
             }
         }
@@ -239,7 +239,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     }
     args.check_method_flags()?;
     let path = args.scene.path();
-    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;
     let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.scene_array_limit())))?;

@@ -26,6 +26,17 @@ impl PassKernel {
         PassKernel::Shade,
     ];
 
+    /// The GLSL file and extra `#define`s of the kernel.
+    pub fn source(self) -> (&'static str, &'static [(&'static str, &'static str)]) {
+        match self {
+            PassKernel::Initial => ("restir_initial.comp", &[]),
+            PassKernel::Temporal => ("restir_temporal.comp", &[]),
+            PassKernel::TemporalUnmoved => ("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")]),
+            PassKernel::Spatial => ("restir_spatial.comp", &[]),
+            PassKernel::Shade => ("restir_shade.comp", &[]),
+        }
+    }
+
     /// The timer slot of the pass (an index into `PASS_NAMES`).
     pub fn timer_slot(self) -> usize {
         match self {

@@ -11,6 +11,7 @@ use super::{Image, RenderSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::scene::Scene;
+use crate::shader_interface::{PathTraceBinding, IMAGE_LOCAL_SIZE};
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
 /// Submissions are sized to about this much GPU time, which keeps GPU watchdogs far away.
@@ -28,7 +29,7 @@ const LOOP_BUDGET_SHARE: f64 = 0.25;
 const STATUS_WORDS: u64 = 5 + 2 * COUNTER_COUNT as u64;
 /// The first word of the profile counters in the Status block.
 const COUNTER_WORDS_START: usize = 4;
-const LOCAL_SIZE: u32 = 8;
+const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
 pub struct RenderStats {
     pub spp: u32,
@@ -93,7 +94,7 @@ impl PathTracer {
         let accum_sq = Buffer::new(ctx, "accumulation of squares", pixels * 16, BufferUsage::Storage)?;
         let status = Buffer::new(ctx, "dispatch status", STATUS_WORDS * 4, BufferUsage::Storage)?;
         let mut bindings = scene_gpu.bindings();
-        bindings.extend([Binding::Storage, Binding::Storage, Binding::Storage]);
+        bindings.extend(PathTraceBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
         let mut defines = scene_gpu.defines();
         if scene_gpu.uniform && scene.triangles.len() <= BRUTE_FORCE_MAX_TRIANGLES {
             defines.push(("SCENE_BRUTE_FORCE", "1"));
@@ -103,8 +104,12 @@ impl PathTracer {
         }
         let mut kernel = Kernel::new(ctx, "pathtrace.comp", &defines, &bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
-        buffers.extend([&accum, &accum_sq, &status]);
-        kernel.bind(&buffers);
+        buffers.extend([
+            PathTraceBinding::Accum.to(&accum),
+            PathTraceBinding::AccumSq.to(&accum_sq),
+            PathTraceBinding::Status.to(&status),
+        ]);
+        kernel.bind(&buffers)?;
         // One dispatch over zero pixels compiles the kernel now (llvmpipe compiles at the first
         // dispatch), so that no sample's GPU time includes it.
         let empty = crate::gpu_types::FrameParams::default();

@@ -13,10 +13,11 @@ use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
 use crate::scene::Scene;
+use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
-const LOCAL_SIZE: u32 = 8;
+const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
 /// Shared memory of one workgroup of the ReSTIR kernels: the path being built by each of its
 /// LOCAL_SIZE² invocations (glsl/shift.glsl, `path_vertices`, `path_lobes`, `path_weights`),
@@ -71,17 +72,6 @@ pub struct Restir {
     surface_slot: u32,
 }
 
-/// The GLSL file and extra `#define`s of each kernel.
-fn kernel_source(kernel: PassKernel) -> (&'static str, &'static [(&'static str, &'static str)]) {
-    match kernel {
-        PassKernel::Initial => ("restir_initial.comp", &[]),
-        PassKernel::Temporal => ("restir_temporal.comp", &[]),
-        PassKernel::TemporalUnmoved => ("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")]),
-        PassKernel::Spatial => ("restir_spatial.comp", &[]),
-        PassKernel::Shade => ("restir_shade.comp", &[]),
-    }
-}
-
 impl Restir {
     /// Uploads `scene`, builds every kernel a run can use and compiles them (see `warm_up`);
     /// the time that took is in `compile_reports`.
@@ -122,12 +112,12 @@ impl Restir {
         let stats = storage("ReSTIR statistics", std::mem::size_of::<RestirStats>() as u64)?;
 
         let mut bindings = scene_gpu.bindings();
-        bindings.extend([Binding::Storage; 14]);
+        bindings.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
         let mut defines = scene_gpu.defines();
         defines.extend(restir.defines());
         let mut kernels = Vec::with_capacity(PassKernel::ALL.len());
         for kernel in PassKernel::ALL {
-            let (file, extra) = kernel_source(kernel);
+            let (file, extra) = kernel.source();
             let all: Vec<_> = defines.iter().chain(extra).copied().collect();
             let mut k = Kernel::new(ctx, file, &all, &bindings, 4)?;
             if kernel == PassKernel::TemporalUnmoved {
@@ -156,7 +146,7 @@ impl Restir {
             history: None,
             surface_slot: 0,
         };
-        restir.bind_buffers();
+        restir.bind_buffers()?;
         restir.warm_up(progress)?;
         Ok(restir)
     }
@@ -192,18 +182,30 @@ impl Restir {
     }
 
     /// Points every kernel's descriptors at the current buffers.
-    fn bind_buffers(&self) {
+    fn bind_buffers(&self) -> Result<()> {
+        use RestirBinding as B;
         let layers = &self.layers;
         let mut buffers = self.scene_gpu.buffers(&self.params);
-        buffers.push(&self.reuse);
-        buffers.extend(self.surfaces.iter());
-        for (h, t) in layers.heads.iter().zip(&layers.tails) {
-            buffers.extend([h, t]);
+        buffers.extend([
+            B::ReuseParams.to(&self.reuse),
+            B::Surfaces0.to(&self.surfaces[0]),
+            B::Surfaces1.to(&self.surfaces[1]),
+        ]);
+        for (slot, (heads, tails)) in layers.heads.iter().zip(&layers.tails).enumerate() {
+            let (head_binding, tail_binding) = B::reservoir_slot(slot);
+            buffers.extend([head_binding.to(heads), tail_binding.to(tails)]);
         }
-        buffers.extend([&layers.direct, &self.accum, &self.accum_sq, &self.stats, &layers.expectation]);
+        buffers.extend([
+            B::Direct.to(&layers.direct),
+            B::Accum.to(&self.accum),
+            B::AccumSq.to(&self.accum_sq),
+            B::RestirStats.to(&self.stats),
+            B::Expectation.to(&layers.expectation),
+        ]);
         for kernel in &self.kernels {
-            kernel.bind(&buffers);
+            kernel.bind(&buffers)?;
         }
+        Ok(())
     }
 
     /// Forgets the temporal history and the accumulated average; the next frame starts a new,
@@ -227,7 +229,7 @@ impl Restir {
         restir.validate(self.settings.max_depth)?;
         if reservoirs != self.restir.reservoirs {
             self.layers = ReservoirLayers::new(&self.ctx, self.settings.pixel_count() as u64, reservoirs)?;
-            self.bind_buffers();
+            self.bind_buffers()?;
             self.history = None;
         }
         self.restir = restir;

@@ -14,8 +14,9 @@ use ash::vk::PhysicalDeviceType;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
+use crate::shader_interface::SceneBinding;
 use crate::shading::bsdf::lobe_weights;
-use crate::vk::{Binding, Buffer, BufferUsage, Context};
+use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context};
 
 pub struct SceneGpu {
     pub triangles: Buffer,
@@ -122,18 +123,31 @@ impl SceneGpu {
         self.addresses.is_some()
     }
 
-    /// The buffers for bindings 0-4, the frame parameters first.
-    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<&'a Buffer> {
-        match &self.addresses {
-            Some([triangles, nodes, emitters]) => vec![params, triangles, nodes, &self.materials, emitters],
-            None => vec![params, &self.triangles, &self.nodes, &self.materials, &self.emitters],
-        }
+    /// The buffers of bindings 0-4, with `params` as the frame parameters. In the addressed
+    /// layout bindings 1, 2 and 4 hold the arrays' addresses.
+    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<BoundBuffer<'a>> {
+        let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
+        let [triangles, nodes, emitters] = match &self.addresses {
+            Some([t, n, e]) => [t, n, e],
+            None => [&self.triangles, &self.nodes, &self.emitters],
+        };
+        vec![
+            SceneBinding::FrameParams.to(params),
+            SceneBinding::Triangles.slot(scene).to(triangles),
+            SceneBinding::Nodes.slot(scene).to(nodes),
+            SceneBinding::Materials.slot(scene).to(&self.materials),
+            SceneBinding::Emitters.slot(scene).to(emitters),
+        ]
     }
 
-    /// The descriptor kinds of bindings 0-4.
-    pub fn bindings(&self) -> Vec<Binding> {
+    /// The layout of bindings 0-4: the frame parameters in a storage buffer, the scene arrays
+    /// in uniform or storage buffers (`uniform`).
+    pub fn bindings(&self) -> Vec<BindingSlot> {
         let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
-        vec![Binding::Storage, scene, scene, scene, scene]
+        SceneBinding::ALL
+            .iter()
+            .map(|&b| b.slot(if b == SceneBinding::FrameParams { Binding::Storage } else { scene }))
+            .collect()
     }
 
     /// The `#define`s every scene kernel is compiled with.

@@ -23,14 +23,14 @@
 
 use glam::Vec3;
 
-use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use crate::gpu_types::{Material, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::scene::PunctualKind;
 use crate::scene::Scene;
-use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, BsdfSample, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
 use crate::shading::lights::{
     emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
-    punctual_pdf, sample_light,
+    punctual_pdf, sample_light, LightSample,
 };
 use crate::shading::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord, MAX_PATH_LENGTH};
 use crate::shading::ray_offset::offset_ray_origin;
@@ -208,7 +208,7 @@ pub fn reconnection_index(scene: &Scene, path: &Path, params: &ShiftParams) -> O
     (2..=path.length()).find(|&r| is_reconnectable(scene, &path.vertices[r - 2], &path.vertices[r - 1], params))
 }
 
-fn material_of(scene: &Scene, v: &Vertex) -> crate::gpu_types::Material {
+pub(crate) fn material_of(scene: &Scene, v: &Vertex) -> Material {
     scene.materials[scene.triangles[v.triangle as usize].material as usize]
 }
 
@@ -223,7 +223,7 @@ fn direction(scene: &Scene, from: &Vertex, to: &Vertex) -> (Vec3, f32) {
     }
 }
 
-fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
+pub(crate) fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
     if vertex_is_punctual(to) {
         let (dir, dist) = direction(scene, from, to);
         return !punctual_occluded(scene, from.pos, from.normal, from.triangle, dir, dist);
@@ -246,7 +246,7 @@ fn visible(scene: &Scene, from: &Vertex, to: &Vertex) -> bool {
 }
 
 /// Radiance emitted by the end vertex `end` towards `from`.
-fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
+pub(crate) fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     if vertex_is_escaped(end) {
         return environment_radiance(scene, end.pos);
     }
@@ -349,39 +349,13 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
         let wo = (prev_pos - x.pos).normalize();
         let m = material_of(scene, &x);
         let (next, lobe, weight) = if i + 1 == length && nee_end {
-            let ls = sample_light(scene, x.pos, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate());
-            if !(ls.pdf > 0.0) {
-                return None;
-            }
-            let end = if is_punctual_light(ls.triangle) {
-                vertex_punctual(scene, ls.triangle)
-            } else if ls.triangle == NO_EMITTER {
-                vertex_escaped(ls.dir)
-            } else {
-                vertex_on_surface(scene, ls.triangle, x.pos + ls.dir * ls.dist)
-            };
+            let (ls, end) = nee_vertex(scene, &x, seed, i)?;
             if !visible(scene, &x, &end) {
                 return None;
             }
             (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, wo, ls.dir).0 / ls.pdf)
         } else {
-            let s = bsdf_sample(&m, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
-            if s.lobe == LOBE_NONE {
-                return None;
-            }
-            let side = if s.wi.dot(x.normal) > 0.0 { x.normal } else { -x.normal };
-            let hit = trace_closest(
-                &scene.nodes,
-                &scene.triangles,
-                offset_ray_origin(x.pos, side, &scene.triangles[x.triangle as usize]),
-                s.wi,
-                1e30,
-            );
-            let next = if hit.triangle == NO_HIT {
-                vertex_escaped(s.wi)
-            } else {
-                hit_vertex(scene, hit)
-            };
+            let (s, next) = bsdf_vertex(scene, &x, wo, &m, seed, i)?;
             (next, s.lobe, s.weight)
         };
         path.lobes.push(lobe);
@@ -390,6 +364,42 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
         prev_pos = x.pos;
     }
     Some(path)
+}
+
+/// The light point NEE at x_i chooses with the path's random numbers, and its light sample;
+/// `None` if none can be chosen. Visibility is left to the caller.
+pub(crate) fn nee_vertex(scene: &Scene, x: &Vertex, seed: u32, i: usize) -> Option<(LightSample, Vertex)> {
+    let ls = sample_light(scene, x.pos, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate());
+    if !(ls.pdf > 0.0) {
+        return None;
+    }
+    let light = if is_punctual_light(ls.triangle) {
+        vertex_punctual(scene, ls.triangle)
+    } else if ls.triangle == NO_EMITTER {
+        vertex_escaped(ls.dir)
+    } else {
+        vertex_on_surface(scene, ls.triangle, x.pos + ls.dir * ls.dist)
+    };
+    Some((ls, light))
+}
+
+/// The BSDF sample at x_i (material `m`, leaving towards `wo`) drawn with the path's random
+/// numbers, and the vertex its ray reaches (its hit, or the environment); `None` if no lobe was
+/// sampled.
+pub(crate) fn bsdf_vertex(scene: &Scene, x: &Vertex, wo: Vec3, m: &Material, seed: u32, i: usize) -> Option<(BsdfSample, Vertex)> {
+    let s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
+    if s.lobe == LOBE_NONE {
+        return None;
+    }
+    let side = if s.wi.dot(x.normal) > 0.0 { x.normal } else { -x.normal };
+    let origin = offset_ray_origin(x.pos, side, &scene.triangles[x.triangle as usize]);
+    let hit = trace_closest(&scene.nodes, &scene.triangles, origin, s.wi, 1e30);
+    let next = if hit.triangle == NO_HIT {
+        vertex_escaped(s.wi)
+    } else {
+        hit_vertex(scene, hit)
+    };
+    Some((s, next))
 }
 
 fn hit_vertex(scene: &Scene, hit: crate::scene::bvh::Hit) -> Vertex {

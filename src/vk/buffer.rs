@@ -7,7 +7,7 @@ use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
 use super::Context;
-use crate::error::{vk_error, GpuError};
+use crate::error::{allocation_error, vk_error, GpuError};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BufferUsage {
@@ -90,16 +90,7 @@ impl Buffer {
             Ok(a) => a,
             Err(e) => {
                 unsafe { ctx.device.destroy_buffer(handle, None) };
-                return Err(match e {
-                    gpu_allocator::AllocationError::OutOfMemory => GpuError::OutOfMemory {
-                        what: name.to_string(),
-                        bytes: size,
-                    },
-                    other => GpuError::OutOfMemory {
-                        what: format!("{name} ({other})"),
-                        bytes: size,
-                    },
-                });
+                return Err(allocation_error(name, size, e));
             }
         };
         if let Err(e) = unsafe { ctx.device.bind_buffer_memory(handle, allocation.memory(), allocation.offset()) } {

@@ -1,4 +1,5 @@
-//! A compute pipeline with one descriptor set of buffers and an optional push-constant block.
+//! A compute pipeline with one descriptor set of buffers, bound by name, and an optional
+//! push-constant block.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -6,6 +7,7 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 use ash::vk;
 
+use super::reflect::check_bindings;
 use super::{compile_kernel, Buffer, Context};
 use crate::error::{vk_error, GpuError};
 
@@ -13,6 +15,38 @@ use crate::error::{vk_error, GpuError};
 pub enum Binding {
     Uniform,
     Storage,
+}
+
+/// One binding of a kernel's descriptor set 0: its number, the GLSL block declared there and
+/// its descriptor kind. src/shader_interface.rs declares those of the renderers' kernels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BindingSlot {
+    pub binding: u32,
+    pub block: &'static str,
+    pub kind: Binding,
+}
+
+impl BindingSlot {
+    /// A storage-buffer binding.
+    pub fn storage(binding: u32, block: &'static str) -> Self {
+        Self {
+            binding,
+            block,
+            kind: Binding::Storage,
+        }
+    }
+
+    /// `buffer` bound to this binding.
+    pub fn to(self, buffer: &Buffer) -> BoundBuffer<'_> {
+        BoundBuffer { slot: self, buffer }
+    }
+}
+
+/// A buffer for the binding `slot` (checked against the kernel's layout by `Kernel::bind`).
+#[derive(Clone, Copy)]
+pub struct BoundBuffer<'a> {
+    pub slot: BindingSlot,
+    pub buffer: &'a Buffer,
 }
 
 impl Binding {
@@ -49,7 +83,7 @@ impl KernelCompile {
 pub struct Kernel {
     pub name: String,
     compile: KernelCompile,
-    bindings: Vec<Binding>,
+    bindings: Vec<BindingSlot>,
     push_bytes: u32,
     pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
@@ -61,14 +95,16 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// Builds the kernel glsl/`name` whose set 0 has `bindings` at indices 0..n.
-    pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], bindings: &[Binding], push_bytes: u32) -> Result<Self> {
+    /// Builds the kernel glsl/`name` whose set 0 has the bindings `layout`. Fails when the
+    /// compiled shader declares a binding that `layout` lacks or names differently.
+    pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], layout: &[BindingSlot], push_bytes: u32) -> Result<Self> {
         let start = Instant::now();
         let spirv = compile_kernel(name, defines)?;
         let glsl_ms = start.elapsed().as_secs_f64() * 1e3;
+        check_bindings(name, &spirv, layout).map_err(anyhow::Error::msg)?;
         let start = Instant::now();
         let mut kernel =
-            Self::from_spirv(ctx, name, &spirv, bindings, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
+            Self::from_spirv(ctx, name, &spirv, layout, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
         kernel.compile = KernelCompile {
             name: name.to_string(),
             spirv_bytes: spirv.len() * 4,
@@ -100,7 +136,7 @@ impl Kernel {
         Ok(())
     }
 
-    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], bindings: &[Binding], push_bytes: u32) -> Result<Self, GpuError> {
+    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], bindings: &[BindingSlot], push_bytes: u32) -> Result<Self, GpuError> {
         let device = &ctx.device;
         // Each handle is owned by `kernel` as soon as it exists, so an early return frees it.
         let mut kernel = Kernel {
@@ -120,11 +156,10 @@ impl Kernel {
         kernel.module = unsafe { device.create_shader_module(&module_info, None) }.map_err(vk_error("creating a shader module"))?;
         let layout_bindings: Vec<_> = bindings
             .iter()
-            .enumerate()
-            .map(|(i, b)| {
+            .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(b.descriptor_type())
+                    .binding(b.binding)
+                    .descriptor_type(b.kind.descriptor_type())
                     .descriptor_count(1)
                     .stage_flags(vk::ShaderStageFlags::COMPUTE)
             })
@@ -152,7 +187,7 @@ impl Kernel {
 
         let mut sizes = Vec::new();
         for kind in [Binding::Uniform, Binding::Storage] {
-            let count = bindings.iter().filter(|&&b| b == kind).count() as u32;
+            let count = bindings.iter().filter(|b| b.kind == kind).count() as u32;
             if count > 0 {
                 sizes.push(vk::DescriptorPoolSize::default().ty(kind.descriptor_type()).descriptor_count(count));
             }
@@ -166,31 +201,55 @@ impl Kernel {
         Ok(kernel)
     }
 
-    /// Points binding i at `buffers[i]`; the caller keeps the buffers alive while dispatching.
-    pub fn bind(&self, buffers: &[&Buffer]) {
-        assert_eq!(
-            buffers.len(),
-            self.bindings.len(),
-            "kernel {} takes {} bindings",
-            self.name,
-            self.bindings.len()
-        );
+    /// Points each binding of the layout at its buffer in `buffers`, matched by number and
+    /// checked by block name and kind; every binding of the layout must be given exactly once.
+    /// The caller keeps the buffers alive while dispatching.
+    pub fn bind(&self, buffers: &[BoundBuffer]) -> Result<()> {
+        for (i, bound) in buffers.iter().enumerate() {
+            let slot = bound.slot;
+            if !self.bindings.contains(&slot) {
+                anyhow::bail!(
+                    "kernel {}: its layout has no binding {} {} ({:?})",
+                    self.name,
+                    slot.binding,
+                    slot.block,
+                    slot.kind
+                );
+            }
+            if buffers[..i].iter().any(|b| b.slot.binding == slot.binding) {
+                anyhow::bail!("kernel {}: binding {} ({}) given twice", self.name, slot.binding, slot.block);
+            }
+        }
+        if let Some(missing) = self.bindings.iter().find(|s| !buffers.iter().any(|b| b.slot.binding == s.binding)) {
+            anyhow::bail!(
+                "kernel {}: no buffer for binding {} ({})",
+                self.name,
+                missing.binding,
+                missing.block
+            );
+        }
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
-            .map(|b| [vk::DescriptorBufferInfo::default().buffer(b.handle).offset(0).range(vk::WHOLE_SIZE)])
+            .map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(b.buffer.handle)
+                    .offset(0)
+                    .range(vk::WHOLE_SIZE)]
+            })
             .collect();
         let writes: Vec<_> = infos
             .iter()
-            .enumerate()
-            .map(|(i, info)| {
+            .zip(buffers)
+            .map(|(info, bound)| {
                 vk::WriteDescriptorSet::default()
                     .dst_set(self.set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(self.bindings[i].descriptor_type())
+                    .dst_binding(bound.slot.binding)
+                    .descriptor_type(bound.slot.kind.descriptor_type())
                     .buffer_info(info)
             })
             .collect();
         unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };
+        Ok(())
     }
 
     /// Records a dispatch of `groups` workgroups with `push` as the push-constant block.

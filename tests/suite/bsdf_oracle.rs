@@ -66,7 +66,10 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
         &ctx,
         "oracle/bsdf_oracle.comp",
         &[],
-        &[bytemuck::cast_slice(&materials), bytemuck::cast_slice(&inputs)],
+        &[
+            ("Materials", bytemuck::cast_slice(&materials)),
+            ("Inputs", bytemuck::cast_slice(&inputs)),
+        ],
         n_items * 12,
         n_items as u32,
     );

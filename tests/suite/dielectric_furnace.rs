@@ -126,7 +126,10 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
         &ctx,
         "oracle/bsdf_oracle.comp",
         &[],
-        &[bytemuck::cast_slice(&materials), bytemuck::cast_slice(&inputs)],
+        &[
+            ("Materials", bytemuck::cast_slice(&materials)),
+            ("Inputs", bytemuck::cast_slice(&inputs)),
+        ],
         items * 12,
         items as u32,
     );

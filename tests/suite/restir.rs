@@ -399,7 +399,7 @@ fn restir_unbiased_cornell_temporal_history() {
 // samples. With 32 renders the unbiased path tracer itself fails 6 to 10 of 64 blocks (1 to 4
 // spp, all too dark), 5 with 128 and 2 with 512; hence the path-tracer control. ReSTIR PT's
 // renders are heavier-tailed still: with 128 renders and inputs chosen from centre surfaces,
-// two configurations failed 4 blocks each, every t negative (docs/restir.md); hence 384.
+// two configurations failed 4 blocks each, every t negative (docs/lab-notebook.md); hence 384.
 #[test]
 #[ignore = "minutes; run with --ignored (docs/restir.md)"]
 fn restir_unbiased_cornell_glossy() {

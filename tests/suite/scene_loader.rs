@@ -284,3 +284,27 @@ fn loader_recentres_a_scene_without_camera_on_its_bounds_centre_in_f64() {
     };
     assert_eq!(bits(&far_scene), bits(&near));
 }
+
+#[test]
+fn loader_names_a_file_that_is_not_gltf_in_one_line() {
+    let png = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR";
+    for (name, bytes) in [
+        ("notes.gltf", b"hello world\n".as_slice()),
+        ("model.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"),
+        ("picture.png", png),
+    ] {
+        let e = load_error(&temp_file(name, bytes));
+        assert!(
+            e.contains(name) && e.contains("not a glTF file") && !e.contains("line 1 column"),
+            "{name}: {e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    let e = load_error(&temp_file("empty.gltf", b" \n"));
+    assert!(e.contains("empty.gltf") && e.contains("empty, not a glTF file"), "{e}");
+    // JSON that is broken or not glTF stays "invalid glTF" with the parser's position or field.
+    let e = load_error(&temp_file("cut.gltf", b"{ \"asset\": { \"version\": "));
+    assert!(e.contains("cut.gltf") && e.contains("invalid glTF") && e.contains("line"), "{e}");
+    let e = load_error(&temp_file("other.gltf", b"{ \"name\": 1 }"));
+    assert!(e.contains("other.gltf") && e.contains("invalid glTF") && e.contains("asset"), "{e}");
+}
