@@ -98,8 +98,11 @@ fn stream_path_candidates_glsl_matches_rust() {
         let out: Vec<Vec4> = crate::common::run_oracle(
             &ctx,
             "oracle/candidates_oracle.comp",
-            &scene_gpu.buffers(&frame),
-            &[bytemuck::cast_slice(&kernel_params), bytemuck::cast_slice(&inputs)],
+            &crate::common::as_storage(scene_gpu.buffers(&frame)),
+            &[
+                ("Params", bytemuck::cast_slice(&kernel_params)),
+                ("Items", bytemuck::cast_slice(&inputs)),
+            ],
             ITEMS * 8 * 4,
             ITEMS as u32,
         );
