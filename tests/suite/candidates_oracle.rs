@@ -95,9 +95,11 @@ fn stream_path_candidates_glsl_matches_rust() {
             .iter()
             .flat_map(|(y1, seed)| [y1.pos.extend(f32::from_bits(y1.triangle)), camera.extend(f32::from_bits(*seed))])
             .collect();
-        let out: Vec<Vec4> = crate::common::run_oracle(
+        // The scene's defines: small scenes are bound as uniform buffers on CPU devices.
+        let out: Vec<Vec4> = crate::common::run_oracle_with_defines(
             &ctx,
             "oracle/candidates_oracle.comp",
+            &scene_gpu.defines(),
             &scene_gpu.buffers(&frame),
             &[
                 ("Params", bytemuck::cast_slice(&kernel_params)),
