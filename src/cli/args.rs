@@ -11,7 +11,7 @@ use glam::Vec3;
 use super::scene_path;
 use super::sweep::SweepMode;
 use crate::image_io::Exposure;
-use crate::render::{RenderSettings, RestirSettings, ReuseMis, ShiftKind};
+use crate::render::{History, RenderSettings, RestirSettings, ReuseMis, ShiftKind};
 use crate::scene::{ArrayLimit, LoadOptions};
 
 /// An on/off switch written `--flag on|off`.
@@ -65,6 +65,10 @@ pub struct RestirArgs {
     /// ReSTIR PT: reuse the previous frame's reservoirs.
     #[arg(long, value_enum, default_value_t = Toggle::from_bool(RestirSettings::default().temporal))]
     pub temporal: Toggle,
+    /// ReSTIR PT: the reservoirs the next frame's temporal reuse reads, those before spatial
+    /// reuse (temporal) or after it (spatial).
+    #[arg(long, value_enum, default_value_t = RestirSettings::default().history)]
+    pub history: History,
     /// ReSTIR PT: spatial neighbours per round (0 turns spatial reuse off; at most 8).
     #[arg(long, default_value_t = RestirSettings::default().spatial)]
     pub spatial: u32,
@@ -98,6 +102,7 @@ impl RestirArgs {
             shift: self.shift,
             mis: self.mis,
             temporal: self.temporal.on(),
+            history: self.history,
             spatial: self.spatial,
             radius: self.radius,
             rounds: self.rounds,
@@ -126,6 +131,11 @@ impl RestirArgs {
             set.temporal != default.temporal,
             "temporal",
             if set.temporal { "on" } else { "off" }.into(),
+        );
+        note(
+            set.history != default.history,
+            "history",
+            format!("{:?}", set.history).to_lowercase(),
         );
         note(set.spatial != default.spatial, "spatial", set.spatial.to_string());
         note(set.radius != default.radius, "radius", set.radius.to_string());

@@ -12,7 +12,7 @@ mod scene_gpu;
 mod settings;
 
 pub use counters::TraversalCounters;
-pub use frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PlannedPass, PASS_NAMES};
+pub use frame_plan::{plan_frame, FramePlan, FrameState, History, PassKernel, PlannedPass, PASS_NAMES};
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir};

@@ -223,6 +223,7 @@ impl Restir {
             unmoved: same_pose(&prev, frame),
             surface_slot: self.surface_slot,
             spatial_rounds: self.restir.spatial_rounds(),
+            history: self.restir.history,
         })
     }
 

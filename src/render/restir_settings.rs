@@ -2,6 +2,7 @@
 
 use anyhow::{bail, Result};
 
+use super::frame_plan::History;
 use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// The shift mapping used for reuse (and, inverted, for its MIS weights). The discriminant is
@@ -104,6 +105,9 @@ pub struct RestirSettings {
     /// reservoir's paths, so extra rays cut its anti-aliasing noise (a light's edge seen by one
     /// jittered ray) without bias, at the cost of one closest-hit trace each.
     pub emission_rays: u32,
+    /// Which reservoirs the next frame's temporal reuse reads: those before spatial reuse or
+    /// after it (docs/restir.md, "Which reservoirs are the history").
+    pub history: History,
     pub normal_threshold: f32,
     pub depth_threshold: f32,
 }
@@ -121,6 +125,7 @@ impl Default for RestirSettings {
             candidates: 1,
             reservoirs: 1,
             emission_rays: 4,
+            history: History::Spatial,
             normal_threshold: 0.9,
             depth_threshold: 0.1,
         }
