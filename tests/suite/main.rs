@@ -9,6 +9,7 @@ mod bvh_oracle;
 mod candidates_oracle;
 mod cli;
 mod cli_behaviour;
+mod cli_measurement;
 mod dielectric_furnace;
 mod furnace;
 mod gris;
