@@ -198,15 +198,34 @@ struct Job<'a> {
 }
 
 impl Job<'_> {
-    /// Prints the frame's line, refuses or warns about non-finite pixels and writes the frame.
-    /// Returns whether the run ends here (the last frame, or Ctrl-C).
-    fn finish_frame(&self, frame: u32, report: &RenderReport, line: &str, image: &crate::render::Image, interrupted: bool) -> Result<bool> {
+    /// Whether the run ends with `frame` (the last frame, or Ctrl-C).
+    fn is_last(&self, frame: u32, interrupted: bool) -> bool {
+        frame + 1 == self.args.frames || interrupted
+    }
+
+    /// Whether `frame`'s image is written: the last frame's, and every frame's with --out-dir.
+    fn writes_image(&self, frame: u32, interrupted: bool) -> bool {
+        self.args.out_dir.is_some() || self.is_last(frame, interrupted)
+    }
+
+    /// Prints the frame's line, refuses or warns about non-finite pixels and writes the frame's
+    /// image if it was read back (`writes_image`). Returns whether the run ends here.
+    fn finish_frame(
+        &self,
+        frame: u32,
+        report: &RenderReport,
+        line: &str,
+        image: Option<&crate::render::Image>,
+        interrupted: bool,
+    ) -> Result<bool> {
         println!("{}{line}", self.args.frame_prefix(frame, self.scene.cameras.len()));
         guard_nonfinite(self.args.allow_nonfinite, self.args.report.as_deref(), frame, report)?;
-        self.outputs.write_frame(frame, image)?;
-        let last = frame + 1 == self.args.frames || interrupted;
-        if last {
-            self.outputs.write_final(image)?;
+        let last = self.is_last(frame, interrupted);
+        if let Some(image) = image {
+            self.outputs.write_frame(frame, image)?;
+            if last {
+                self.outputs.write_final(image)?;
+            }
         }
         Ok(last)
     }
@@ -317,7 +336,7 @@ fn render_path_traced(job: &Job) -> Result<RenderReport> {
         if stats.interrupted {
             eprintln!("interrupted: writing the {} spp of frame {frame} accumulated so far", stats.spp);
         }
-        if job.finish_frame(frame, &report, &report.summary_line(), &image, stats.interrupted)? {
+        if job.finish_frame(frame, &report, &report.summary_line(), Some(&image), stats.interrupted)? {
             return Ok(report);
         }
         frame += 1;
@@ -338,21 +357,27 @@ fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
     let (mut frame_ms, mut frame) = (vec![], 0);
     loop {
         let stats = renderer.frame(job.scene, args.frame_camera(frame, job.scene.cameras.len()), args.static_camera)?;
-        let image = renderer.image()?;
+        let interrupted = interrupt.load(Ordering::Relaxed);
         frame_ms.push(stats.gpu_ms().unwrap_or(stats.wall_ms));
         let detail = RestirFrameReport::from_stats(frame + 1, &stats);
         let mut report = job.report(restir.label(), spp, frame_ms[frame as usize], stats.wall_ms, compile_ms);
         report.set_frame_times(&frame_ms);
         report.paths_per_second = settings.pixel_count() as f64 * spp as f64 / (report.gpu_ms * 1e-3);
-        report.nonfinite_pixels = image.non_finite_count();
+        // The image is read back only when it is written or when the shading pass counted a
+        // non-finite pixel (then the host count is the one reported and guarded).
+        let image = if job.writes_image(frame, interrupted) || detail.nonfinite_pixels > 0 {
+            Some(renderer.image()?)
+        } else {
+            None
+        };
+        report.nonfinite_pixels = image.as_ref().map_or(0, |image| image.non_finite_count());
         report.nonfinite_weights = detail.nonfinite_weights as u64;
         let line = format!("{} | {}", report.summary_line(), detail.summary());
         report.restir = Some(detail);
-        let interrupted = interrupt.load(Ordering::Relaxed);
         if interrupted {
             eprintln!("interrupted: writing frame {frame}");
         }
-        if job.finish_frame(frame, &report, &line, &image, interrupted)? {
+        if job.finish_frame(frame, &report, &line, image.as_ref(), interrupted)? {
             if frame > 0 {
                 let total: f64 = frame_ms.iter().sum();
                 eprintln!(
