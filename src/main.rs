@@ -58,6 +58,12 @@ fn run(command: Option<Command>) -> anyhow::Result<()> {
 }
 
 fn main() -> ExitCode {
+    // A closed pipe (`restir-pt info | head -1`) ends the process quietly, as it does other
+    // command-line tools, instead of making println! panic on EPIPE.
+    // SAFETY: called before any thread exists; SIG_DFL is a valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     match run(Cli::parse().command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -49,13 +49,18 @@ impl Camera {
     /// along -[`DEFAULT_VIEW_DIRECTION`] (from the +Z side, glTF's front, 26.6 degrees above the
     /// horizon so that flat ground is seen), from the distance at which their bounding sphere just
     /// fills a vertical field of view of [`DEFAULT_YFOV`] (r / sin(yfov / 2) from the centre).
+    /// Its aspect ratio is 1: `--width` alone gives a square image, and a non-square image is
+    /// fitted around the square view, so the sphere stays whole either way.
     pub fn framing(bounds: (Vec3, Vec3)) -> Camera {
         let (lo, hi) = bounds;
         let centre = 0.5 * (lo + hi);
         let radius = (0.5 * (hi - lo).length()).max(1e-6);
         let distance = radius / (0.5 * DEFAULT_YFOV).sin();
         let eye = centre + DEFAULT_VIEW_DIRECTION * distance;
-        Camera::look_at("default camera", eye, centre, Vec3::Y, DEFAULT_YFOV)
+        Camera {
+            aspect_ratio: Some(1.0),
+            ..Camera::look_at("default camera", eye, centre, Vec3::Y, DEFAULT_YFOV)
+        }
     }
 
     pub fn look_at(name: &str, eye: Vec3, target: Vec3, up: Vec3, yfov: f32) -> Camera {
@@ -138,7 +143,16 @@ pub fn camera_on_path(start: usize, frame: u32, cameras: usize) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use super::camera_on_path;
+    use super::{camera_on_path, Camera};
+    use glam::Vec3;
+
+    #[test]
+    fn framing_camera_is_square_when_one_side_is_given() {
+        let camera = Camera::framing((Vec3::splat(-1.0), Vec3::new(3.0, 1.0, 1.0)));
+        assert_eq!(camera.image_size(Some(128), None), (128, 128));
+        assert_eq!(camera.image_size(None, Some(64)), (64, 64));
+        assert_eq!(camera.image_size(Some(200), Some(100)), (200, 100));
+    }
 
     #[test]
     fn camera_path_goes_back_and_forth_and_moves_every_frame() {
