@@ -24,4 +24,6 @@ pub mod rng;
 pub mod sampling;
 pub mod scene;
 pub mod shift;
+pub mod surface;
+pub mod texture;
 pub mod vk;

@@ -36,6 +36,7 @@ use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::sampling::balance_heuristic;
 use crate::scene::PunctualKind;
 use crate::scene::Scene;
+use crate::surface::triangle_bary;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
 pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
@@ -189,7 +190,7 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
     if v.is_escaped() || v.is_punctual() {
         return true;
     }
-    let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
+    let m = &material_of(scene, v);
     let (_, w_c, w_t) = lobe_weights(m);
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
     // An index-matched dielectric is a pass-through, a delta lobe at any roughness.
@@ -209,7 +210,7 @@ pub fn reconnection_index(scene: &Scene, path: &Path, params: &ShiftParams) -> O
 }
 
 fn material_of(scene: &Scene, v: &Vertex) -> crate::gpu_types::Material {
-    scene.materials[scene.triangles[v.triangle as usize].material as usize]
+    scene.material_at(v.triangle, triangle_bary(&scene.triangles[v.triangle as usize], v.pos))
 }
 
 /// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
@@ -257,7 +258,7 @@ fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     if tri.emitter == NO_EMITTER {
         return Vec3::ZERO;
     }
-    emitted_radiance(scene, tri, (from.pos - end.pos).normalize())
+    emitted_radiance(scene, end.triangle, triangle_bary(tri, end.pos), (from.pos - end.pos).normalize())
 }
 
 /// Solid-angle pdf that NEE at `from` picks `end`; for a punctual light the discrete probability

@@ -129,7 +129,7 @@ impl Restir {
         for kernel in PassKernel::ALL {
             let (file, extra) = kernel_source(kernel);
             let all: Vec<_> = defines.iter().chain(extra).copied().collect();
-            let mut k = Kernel::new(ctx, file, &all, &bindings, 4)?;
+            let mut k = scene_gpu.kernel(ctx, file, &all, bindings.clone(), 4)?;
             if kernel == PassKernel::TemporalUnmoved {
                 k.set_variant("(unmoved camera)");
             }

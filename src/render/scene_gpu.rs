@@ -10,7 +10,10 @@ use crate::bsdf::lobe_weights;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
-use crate::vk::{Binding, Buffer, Context};
+use crate::texture::NO_TEXTURE;
+use crate::vk::{Binding, Buffer, Context, Kernel};
+
+use super::surface_gpu::SurfaceGpu;
 
 pub struct SceneGpu {
     pub triangles: Buffer,
@@ -19,6 +22,8 @@ pub struct SceneGpu {
     pub emitters: Buffer,
     /// Scene arrays are bound as uniform buffers (CPU devices, small scenes), else storage buffers.
     pub uniform: bool,
+    /// Surface attributes and textures (descriptor set 1), if the scene has any.
+    pub surface: Option<SurfaceGpu>,
     defines: Vec<(&'static str, String)>,
 }
 
@@ -75,6 +80,7 @@ impl SceneGpu {
             )?,
             emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &emitter_rows))?,
             uniform,
+            surface: SurfaceGpu::upload(ctx, scene)?,
             defines: scene_defines(scene, uniform),
         })
     }
@@ -90,6 +96,27 @@ impl SceneGpu {
         vec![Binding::Storage, scene, scene, scene, scene]
     }
 
+    /// The bindings of each descriptor set of a scene kernel whose set 0 is `set0`: set 1 holds
+    /// the surface attributes and textures when the scene has them.
+    pub fn sets(&self, set0: Vec<Binding>) -> Vec<Vec<Binding>> {
+        let mut sets = vec![set0];
+        if let Some(s) = &self.surface {
+            sets.push(s.bindings());
+        }
+        sets
+    }
+
+    /// Builds scene kernel glsl/`name` with set 0 `set0` (bound by the caller) and binds set 1.
+    pub fn kernel(&self, ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], set0: Vec<Binding>, push_bytes: u32) -> Result<Kernel> {
+        let sets = self.sets(set0);
+        let refs: Vec<&[Binding]> = sets.iter().map(Vec::as_slice).collect();
+        let kernel = Kernel::with_sets(ctx, name, defines, &refs, push_bytes)?;
+        if let Some(s) = &self.surface {
+            kernel.bind_set(1, &s.buffers.iter().collect::<Vec<_>>());
+        }
+        Ok(kernel)
+    }
+
     /// The `#define`s every scene kernel is compiled with.
     pub fn defines(&self) -> Vec<(&str, &str)> {
         self.defines.iter().map(|(k, v)| (*k, v.as_str())).collect()
@@ -99,7 +126,23 @@ impl SceneGpu {
 /// Specialises kernels to the BSDF lobes and light types the scene uses, and sizes the uniform
 /// arrays when the scene is bound as uniform buffers.
 fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
-    let used = |pick: fn((f32, f32, f32)) -> f32| scene.materials.iter().any(|m| pick(lobe_weights(m)) > 0.0);
+    // A metallic-roughness texture scales metallic anywhere down to 0, which brings in the
+    // non-metal lobes.
+    let variants: Vec<Material> = scene
+        .materials
+        .iter()
+        .enumerate()
+        .flat_map(|(i, m)| {
+            let textured = scene
+                .textures
+                .materials
+                .get(i)
+                .is_some_and(|t| t.metal_rough.texture_index != NO_TEXTURE);
+            let dielectric = Material { metallic: 0.0, ..*m };
+            std::iter::once(*m).chain(textured.then_some(dielectric))
+        })
+        .collect();
+    let used = |pick: fn((f32, f32, f32)) -> f32| variants.iter().any(|m| pick(lobe_weights(m)) > 0.0);
     let flag = |on: bool| if on { "1" } else { "0" }.to_string();
     let mut defines = vec![
         ("BSDF_DIFFUSE", flag(used(|w| w.0))),
@@ -111,6 +154,8 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_ENV_MAP", flag(scene.environment_map.is_some())),
         ("SCENE_ENV_MAP_BASE", format!("{}u", PUNCTUAL_ROWS * scene.lights.len())),
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
+        ("SCENE_SURFACE", flag(!scene.surfaces.is_empty())),
+        ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
     ];
     if uniform {
         defines.extend([

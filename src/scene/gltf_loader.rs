@@ -11,6 +11,8 @@ use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
 use crate::environment::EnvironmentMap;
 use crate::gpu_types::{Material, Triangle};
+use crate::surface::TriangleSurface;
+use crate::texture::SceneTextures;
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
 pub(super) const MAX_NODE_DEPTH: usize = 256;
@@ -20,12 +22,19 @@ pub(super) const MAX_TRIANGLES: usize = 1 << 26;
 
 pub(super) struct Loader<'a> {
     pub(super) path: &'a Path,
+    /// The folder external images resolve against (none: only embedded images).
+    pub(super) base: Option<&'a Path>,
     pub(super) doc: &'a gltf::Document,
     pub(super) buffers: &'a [gltf::buffer::Data],
     pub(super) instancing: &'a HashMap<usize, Instancing>,
     pub(super) triangles: Vec<Triangle>,
+    /// Vertex attributes parallel to `triangles`, from the first triangle that has any (earlier
+    /// ones are flat); empty while none has.
+    pub(super) surfaces: Vec<TriangleSurface>,
     pub(super) materials: Vec<Material>,
     pub(super) material_names: Vec<String>,
+    /// The glTF material each of `materials` comes from (none: the default material).
+    pub(super) material_sources: Vec<Option<usize>>,
     /// Whether each material is `KHR_materials_unlit` (its emission is its base colour).
     pub(super) unlit: Vec<bool>,
     /// Index of the glTF default material in `materials`, added on first use.
@@ -52,6 +61,8 @@ pub(super) struct MeshCounts {
     pub degenerate_emitters: usize,
     pub points_or_lines: usize,
     pub colour_varying: usize,
+    /// Some vertex normal differs from its face's normal.
+    pub smooth: bool,
     pub instances: usize,
     /// World-space bounds of the skipped points and lines (frame a scene made only of them).
     pub skipped_bounds: Option<(Vec3, Vec3)>,
@@ -118,12 +129,15 @@ fn load_bytes_reporting(
     }
     let mut loader = Loader {
         path,
+        base,
         doc: &document,
         buffers: &buffers,
         instancing: &raw.instancing,
         triangles: Vec::new(),
+        surfaces: Vec::new(),
         materials: Vec::new(),
         material_names: Vec::new(),
+        material_sources: Vec::new(),
         unlit: Vec::new(),
         default_material: None,
         colour_variants: HashMap::new(),
@@ -234,7 +248,9 @@ impl<'a> Loader<'a> {
             None => scene_environment(self.path, &scene, doc)?,
         };
         let map = options.environment_map.as_deref().map(EnvironmentMap::load).transpose()?;
-        self.finish(environment, map)
+        let sources = std::mem::take(&mut self.material_sources);
+        let textures = self.load_textures(&sources, options.max_binding_bytes.unwrap_or(u64::MAX).min(u32::MAX as u64))?;
+        self.finish(environment, map, textures)
     }
 
     /// Walks the hierarchy in f64 and re-centres the scene before rounding to f32: on its first
@@ -320,9 +336,19 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>) -> Result<Scene> {
+    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>, textures: SceneTextures) -> Result<Scene> {
         let this = self;
         let skipped_bounds = this.counts.skipped_bounds;
+        // Flat faces without textures need no attributes: their kernels do without.
+        let surfaces = if this.counts.smooth || !textures.is_empty() {
+            let mut s = std::mem::take(&mut this.surfaces);
+            if !s.is_empty() {
+                s.resize(this.triangles.len(), TriangleSurface::flat());
+            }
+            s
+        } else {
+            Vec::new()
+        };
         this.report_counts();
         let bounds = match skipped_bounds {
             Some(b) if this.triangles.is_empty() => {
@@ -357,6 +383,8 @@ impl<'a> Loader<'a> {
         let mut scene = Scene::build(SceneParts {
             source: this.path.to_path_buf(),
             triangles: std::mem::take(&mut this.triangles),
+            surfaces,
+            textures,
             materials: std::mem::take(&mut this.materials),
             material_names: std::mem::take(&mut this.material_names),
             environment,

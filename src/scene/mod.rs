@@ -6,6 +6,9 @@ mod gltf_json;
 mod gltf_loader;
 mod gltf_material;
 mod gltf_mesh;
+mod gltf_surface;
+mod gltf_texture;
+mod hit_surface;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
@@ -21,6 +24,8 @@ use crate::bvh::Bvh;
 use crate::environment::EnvironmentMap;
 use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::lights::build_alias_table;
+use crate::surface::TriangleSurface;
+use crate::texture::SceneTextures;
 
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
@@ -28,6 +33,11 @@ const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
 pub struct Scene {
     pub source: PathBuf,
     pub triangles: Vec<Triangle>,
+    /// Vertex attributes of `triangles` (same order), or empty: a scene of flat faces without
+    /// textures has none (see src/surface.rs).
+    pub surfaces: Vec<TriangleSurface>,
+    /// The materials' textures (empty: none).
+    pub textures: SceneTextures,
     pub nodes: Vec<BvhNode>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
@@ -65,6 +75,9 @@ pub fn luminance(c: Vec3) -> f32 {
 pub struct SceneParts {
     pub source: PathBuf,
     pub triangles: Vec<Triangle>,
+    /// Vertex attributes parallel to `triangles`, or empty.
+    pub surfaces: Vec<TriangleSurface>,
+    pub textures: SceneTextures,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     pub environment: Vec3,
@@ -81,6 +94,11 @@ impl Scene {
         let start = std::time::Instant::now();
         let bvh = Bvh::build(&parts.triangles);
         let mut triangles: Vec<Triangle> = bvh.order.iter().map(|&i| parts.triangles[i as usize]).collect();
+        let surfaces: Vec<TriangleSurface> = if parts.surfaces.is_empty() {
+            Vec::new()
+        } else {
+            bvh.order.iter().map(|&i| parts.surfaces[i as usize]).collect()
+        };
         let mut emitter_tris = Vec::new();
         let mut powers = Vec::new();
         for (i, tri) in triangles.iter_mut().enumerate() {
@@ -122,6 +140,8 @@ impl Scene {
         Scene {
             source: parts.source,
             triangles,
+            surfaces,
+            textures: parts.textures,
             nodes: bvh.nodes,
             materials: parts.materials,
             material_names: parts.material_names,

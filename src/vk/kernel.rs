@@ -1,4 +1,5 @@
-//! A compute pipeline with one descriptor set of buffers and an optional push-constant block.
+//! A compute pipeline with descriptor sets of buffers (set 0, and optionally set 1) and an
+//! optional push-constant block.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -49,13 +50,14 @@ impl KernelCompile {
 pub struct Kernel {
     pub name: String,
     compile: KernelCompile,
-    bindings: Vec<Binding>,
+    /// The bindings of each descriptor set, set 0 first.
+    bindings: Vec<Vec<Binding>>,
     push_bytes: u32,
     pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
-    set_layout: vk::DescriptorSetLayout,
+    set_layouts: Vec<vk::DescriptorSetLayout>,
     pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
+    sets: Vec<vk::DescriptorSet>,
     module: vk::ShaderModule,
     ctx: Arc<Context>,
 }
@@ -63,12 +65,18 @@ pub struct Kernel {
 impl Kernel {
     /// Builds the kernel glsl/`name` whose set 0 has `bindings` at indices 0..n.
     pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], bindings: &[Binding], push_bytes: u32) -> Result<Self> {
+        Self::with_sets(ctx, name, defines, &[bindings], push_bytes)
+    }
+
+    /// Builds the kernel glsl/`name` whose set k has `sets[k]` at indices 0..n (an empty set
+    /// still gets its layout, so that later sets keep their numbers).
+    pub fn with_sets(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], sets: &[&[Binding]], push_bytes: u32) -> Result<Self> {
         let start = Instant::now();
         let spirv = compile_kernel(name, defines)?;
         let glsl_ms = start.elapsed().as_secs_f64() * 1e3;
         let start = Instant::now();
         let mut kernel =
-            Self::from_spirv(ctx, name, &spirv, bindings, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
+            Self::from_spirv(ctx, name, &spirv, sets, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
         kernel.compile = KernelCompile {
             name: name.to_string(),
             spirv_bytes: spirv.len() * 4,
@@ -100,39 +108,42 @@ impl Kernel {
         Ok(())
     }
 
-    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], bindings: &[Binding], push_bytes: u32) -> Result<Self, GpuError> {
+    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], sets: &[&[Binding]], push_bytes: u32) -> Result<Self, GpuError> {
         let device = &ctx.device;
         // Each handle is owned by `kernel` as soon as it exists, so an early return frees it.
         let mut kernel = Kernel {
             name: name.to_string(),
             compile: KernelCompile::default(),
-            bindings: bindings.to_vec(),
+            bindings: sets.iter().map(|b| b.to_vec()).collect(),
             push_bytes,
             pipeline: vk::Pipeline::null(),
             layout: vk::PipelineLayout::null(),
-            set_layout: vk::DescriptorSetLayout::null(),
+            set_layouts: Vec::new(),
             pool: vk::DescriptorPool::null(),
-            set: vk::DescriptorSet::null(),
+            sets: Vec::new(),
             module: vk::ShaderModule::null(),
             ctx: ctx.clone(),
         };
         let module_info = vk::ShaderModuleCreateInfo::default().code(spirv);
         kernel.module = unsafe { device.create_shader_module(&module_info, None) }.map_err(vk_error("creating a shader module"))?;
-        let layout_bindings: Vec<_> = bindings
-            .iter()
-            .enumerate()
-            .map(|(i, b)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(b.descriptor_type())
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        let set_layout_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
-        kernel.set_layout =
-            unsafe { device.create_descriptor_set_layout(&set_layout_info, None) }.map_err(vk_error("creating a descriptor set layout"))?;
-        let set_layouts = [kernel.set_layout];
+        for bindings in sets {
+            let layout_bindings: Vec<_> = bindings
+                .iter()
+                .enumerate()
+                .map(|(i, b)| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(i as u32)
+                        .descriptor_type(b.descriptor_type())
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::COMPUTE)
+                })
+                .collect();
+            let set_layout_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
+            let set_layout = unsafe { device.create_descriptor_set_layout(&set_layout_info, None) }
+                .map_err(vk_error("creating a descriptor set layout"))?;
+            kernel.set_layouts.push(set_layout);
+        }
+        let set_layouts = kernel.set_layouts.clone();
         let ranges = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::COMPUTE)
             .size(push_bytes)];
@@ -152,28 +163,36 @@ impl Kernel {
 
         let mut sizes = Vec::new();
         for kind in [Binding::Uniform, Binding::Storage] {
-            let count = bindings.iter().filter(|&&b| b == kind).count() as u32;
+            let count = sets.iter().flat_map(|b| b.iter()).filter(|&&b| b == kind).count() as u32;
             if count > 0 {
                 sizes.push(vk::DescriptorPoolSize::default().ty(kind.descriptor_type()).descriptor_count(count));
             }
         }
-        let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
+        let pool_info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(sets.len() as u32)
+            .pool_sizes(&sizes);
         kernel.pool = unsafe { device.create_descriptor_pool(&pool_info, None) }.map_err(vk_error("creating a descriptor pool"))?;
         let alloc_info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(kernel.pool)
             .set_layouts(&set_layouts);
-        kernel.set = unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_error("allocating a descriptor set"))?[0];
+        kernel.sets = unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_error("allocating descriptor sets"))?;
         Ok(kernel)
     }
 
-    /// Points binding i at `buffers[i]`; the caller keeps the buffers alive while dispatching.
+    /// Points binding i of set 0 at `buffers[i]`; the caller keeps the buffers alive while
+    /// dispatching.
     pub fn bind(&self, buffers: &[&Buffer]) {
+        self.bind_set(0, buffers);
+    }
+
+    /// Points binding i of set `set` at `buffers[i]`.
+    pub fn bind_set(&self, set: usize, buffers: &[&Buffer]) {
         assert_eq!(
             buffers.len(),
-            self.bindings.len(),
-            "kernel {} takes {} bindings",
+            self.bindings[set].len(),
+            "kernel {} takes {} bindings in set {set}",
             self.name,
-            self.bindings.len()
+            self.bindings[set].len()
         );
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
@@ -184,9 +203,9 @@ impl Kernel {
             .enumerate()
             .map(|(i, info)| {
                 vk::WriteDescriptorSet::default()
-                    .dst_set(self.set)
+                    .dst_set(self.sets[set])
                     .dst_binding(i as u32)
-                    .descriptor_type(self.bindings[i].descriptor_type())
+                    .descriptor_type(self.bindings[set][i].descriptor_type())
                     .buffer_info(info)
             })
             .collect();
@@ -205,7 +224,7 @@ impl Kernel {
         let device = &self.ctx.device;
         unsafe {
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.set], &[]);
+            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &self.sets, &[]);
             if !push.is_empty() {
                 device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
@@ -245,7 +264,9 @@ impl Drop for Kernel {
             device.destroy_pipeline(self.pipeline, None);
             device.destroy_pipeline_layout(self.layout, None);
             device.destroy_descriptor_pool(self.pool, None);
-            device.destroy_descriptor_set_layout(self.set_layout, None);
+            for &layout in &self.set_layouts {
+                device.destroy_descriptor_set_layout(layout, None);
+            }
             device.destroy_shader_module(self.module, None);
         }
     }

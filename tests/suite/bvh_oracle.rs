@@ -102,6 +102,8 @@ fn random_scene_full(seed: u64, lights: Vec<PunctualLight>, environment_map: Opt
     ];
     Scene::build(SceneParts {
         source: "random test scene".into(),
+        surfaces: Vec::new(),
+        textures: Default::default(),
         triangles,
         materials,
         material_names: vec!["grey".into(), "light".into()],

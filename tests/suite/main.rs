@@ -24,5 +24,6 @@ mod scene_loader;
 mod scenes;
 mod shift;
 mod speed_accuracy;
+mod surface_oracle;
 mod sweeps;
 mod trace_pair_oracle;

@@ -1,0 +1,57 @@
+//! The surface attributes and textures of a scene on the device: descriptor set 1 of scene
+//! kernels (glsl/surface_bindings.glsl), present only when the scene has them.
+
+use std::sync::Arc;
+
+use anyhow::{Context as _, Result};
+
+use crate::scene::Scene;
+use crate::vk::{Binding, Buffer, Context};
+
+/// Set 1's buffers: the per-triangle attributes, then (with textures) the material texture
+/// table, the texture headers and the texels.
+pub struct SurfaceGpu {
+    pub buffers: Vec<Buffer>,
+    /// Bytes uploaded for textures (texels, headers, material table).
+    pub texture_bytes: usize,
+    /// Bytes uploaded for the per-triangle attributes.
+    pub attribute_bytes: usize,
+}
+
+impl SurfaceGpu {
+    /// `None` for a scene without attributes (flat faces and no textures).
+    pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<Option<Self>> {
+        if scene.surfaces.is_empty() {
+            return Ok(None);
+        }
+        let source = scene.source.display();
+        let mut buffers = vec![Buffer::from_slice(ctx, "surface attributes", &scene.surfaces)
+            .with_context(|| format!("{source}: uploading the surface attributes"))?];
+        let t = &scene.textures;
+        if !t.is_empty() {
+            // Vulkan has no empty buffers: a scene whose only non-opaque material has no texture.
+            let headers = if t.headers.is_empty() {
+                vec![Default::default()]
+            } else {
+                t.headers.clone()
+            };
+            let texels = if t.texels.is_empty() { vec![0u32] } else { t.texels.clone() };
+            let upload = |name: &str, r: Result<Buffer, crate::error::GpuError>| r.with_context(|| format!("{source}: uploading {name}"));
+            buffers.push(upload(
+                "material textures",
+                Buffer::from_slice(ctx, "material textures", &t.materials),
+            )?);
+            buffers.push(upload("texture headers", Buffer::from_slice(ctx, "texture headers", &headers))?);
+            buffers.push(upload("texels", Buffer::from_slice(ctx, "texels", &texels))?);
+        }
+        Ok(Some(Self {
+            buffers,
+            texture_bytes: t.gpu_bytes(),
+            attribute_bytes: std::mem::size_of_val(scene.surfaces.as_slice()),
+        }))
+    }
+
+    pub fn bindings(&self) -> Vec<Binding> {
+        vec![Binding::Storage; self.buffers.len()]
+    }
+}
