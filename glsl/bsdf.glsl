@@ -1,6 +1,6 @@
 // The material model (docs/materials.md): a linear blend of a Lambertian lobe, a GGX conductor
 // and a GGX (or smooth) dielectric. All directions point away from the surface; n is the geometric
-// normal as wound. Twin: src/bsdf.rs.
+// normal as wound. Twin: src/shading/bsdf.rs.
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
 

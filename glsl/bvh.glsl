@@ -1,5 +1,5 @@
 // Ray-triangle intersection and stack traversal of the flattened BVH. Expects the scene buffers
-// `triangles` and `nodes` (scene_bindings.glsl). Twin: src/bvh.rs.
+// `triangles` and `nodes` (scene_bindings.glsl). Twin: src/scene/bvh.rs.
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
@@ -61,7 +61,7 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     hit.bary = vec2(0.0);
     vec3 inv_d = safe_inverse(d);
     vec3 o_inv_d = o * inv_d;
-    uint end = nodes.length();
+    uint end = SCENE_NODES_LENGTH;
     uint node = 0u;
     count_lane(COUNTER_TRAVERSALS);
     while (node < end) {
@@ -116,14 +116,6 @@ void segment_ray(vec3 p, vec3 np, uint tp, vec3 q, vec3 nq, uint tq, out vec3 or
     vec3 target = offset_ray_origin(q, dot(d, nq) < 0.0 ? nq : -nq, triangles[tq]);
     dir = target - origin;
     tmax = 1.0 - SEGMENT_EPSILON;
-}
-
-// Whether anything blocks the segment between surface points p and q (see segment_ray).
-bool segment_occluded(vec3 p, vec3 np, uint tp, vec3 q, vec3 nq, uint tq) {
-    vec3 origin, dir;
-    float tmax;
-    segment_ray(p, np, tp, q, nq, tq, origin, dir, tmax);
-    return trace_occluded(origin, dir, tmax);
 }
 
 #endif

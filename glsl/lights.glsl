@@ -2,7 +2,7 @@
 // table, uniform area sampling, and a constant environment sampled uniformly over the sphere. A
 // punctual light's sample is a delta: pdf is the discrete probability of choosing it, radiance
 // is I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
-// `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: src/lights.rs.
+// `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: src/shading/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
 
@@ -21,7 +21,7 @@
 #ifndef SCENE_PUNCTUAL
 #define SCENE_PUNCTUAL 1
 #endif
-// An equirectangular environment map (src/environment.rs) replaces the constant environment; its
+// An equirectangular environment map (src/scene/environment.rs) replaces the constant environment; its
 // rows start SCENE_ENV_MAP_BASE rows after the alias table in the emitter buffer.
 #ifndef SCENE_ENV_MAP
 #define SCENE_ENV_MAP 0
@@ -197,7 +197,8 @@ float environment_pdf(vec3 dir) {
 #endif
 }
 
-// A direction to the environment from u in [0, 1)^2 (by luminance for a map).
+// A direction to the environment from u in [0, 1)^2 (by luminance for a map). Twin:
+// Environment::sample_environment (src/scene/environment.rs) for a map.
 vec3 sample_environment(vec2 u) {
 #if SCENE_ENV_MAP
     uvec2 size = env_size();

@@ -1,4 +1,4 @@
-// Shadow rays towards punctual lights. Expects bvh.glsl and lights.glsl. Twin: src/lights.rs.
+// Shadow rays towards punctual lights. Expects bvh.glsl and lights.glsl. Twin: src/shading/lights.rs.
 #ifndef PUNCTUAL_GLSL
 #define PUNCTUAL_GLSL
 

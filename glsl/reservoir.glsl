@@ -66,7 +66,8 @@ Reservoir reservoir_join(ReservoirHead h, ReservoirTail t) {
 // i with probability w_i / sum w and W = sum w / p̂(chosen).
 // `expected` is the expectation of f(Y) W_Y over the choice, sum w_i f(y_i) / p̂(y_i): the
 // pixel is shaded with it, which removes the choice's noise (chiefly colour noise, as p̂ is
-// luminance) without bias. Twin: gris::resampled_expectation.
+// luminance) without bias. Twins: gris::Resampler, resampler_begin, resampler_offer and
+// resampler_finish in src/shading/gris.rs (`expected`: gris::resampled_expectation).
 struct Resampler {
     PathRecord chosen;
     float chosen_target;

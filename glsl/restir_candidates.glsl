@@ -3,7 +3,7 @@
 // technique can make is offered by both, each weighted by the balance heuristic
 // (end_mis_weight in shift.glsl): the two weighted integrands sum to the path's, and each is a
 // function of the path that the shifts evaluate anew (the end type travels in the record). The
-// paths are built with the steps generate_path() in shift.glsl regenerates them with
+// paths are built with the steps trace_vertices() in shift.glsl regenerates them with
 // (nee_vertex, bsdf_vertex).
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL

@@ -1,28 +1,22 @@
-// GRIS across pixels and frames (../shared/docs/math.md sections 2-4): inputs from other domains
-// are shifted into the canonical pixel's domain, weighted by resampling MIS weights computed with
-// inverse shifts, and one is chosen. Twin of src/gris.rs (mis_weight, resample), whose toy test
-// checks the estimator; SHIFT_MODE and MIS_MODE select the shift and the MIS at compile time.
+// GRIS across pixels and frames (docs/restir.md): inputs from other domains are shifted into the
+// canonical pixel's domain, weighted by resampling MIS weights (gris.glsl) computed with inverse
+// shifts, and one is chosen by the streaming resampler (reservoir.glsl). The estimator is
+// src/shading/gris.rs's, whose toy test checks it; SHIFT_MODE and MIS_MODE select the shift and the MIS
+// at compile time.
 #ifndef RESTIR_REUSE_GLSL
 #define RESTIR_REUSE_GLSL
 
 #include "restir_bindings.glsl"
 #include "camera.glsl"
+#include "gris.glsl"
 #include "shift.glsl"
 
 #define SHIFT_RECONNECTION 0
 #define SHIFT_REPLAY 1
 #define SHIFT_HYBRID 2
-#define MIS_GBH 0
-#define MIS_PAIRWISE 1
 #ifndef SHIFT_MODE
 #define SHIFT_MODE SHIFT_HYBRID
 #endif
-#ifndef MIS_MODE
-#define MIS_MODE MIS_GBH
-#endif
-
-// Canonical input plus up to 8 neighbours.
-const uint MAX_INPUTS = 9u;
 
 // The domain of a reservoir: one pixel's paths seen from one frame's camera, the sub-pixel
 // position included. A path carries its own position (the camera stream of its seed), so a
@@ -35,15 +29,15 @@ struct Domain {
     bool previous;   // seen from the previous frame's camera
 };
 
-// One input of a resampling: the reservoir at `index` of reservoir slot `slot`, of `domain`, and
-// its confidence weight c. The reservoir stays in its buffer until it is resampled: lavapipe
-// turns a run-time index into a local array into selects over every element, so an array of
-// whole reservoirs cost more compile and run time than the loads.
+// One input of a resampling: the reservoir at `index` of reservoir slot `slot`, of `domain`; its
+// confidence weight c is `confidences` (gris.glsl) at the same index. The reservoir stays in its
+// buffer until it is resampled: lavapipe turns a run-time index into a local array into selects
+// over every element, so an array of whole reservoirs cost more compile and run time than the
+// loads.
 struct ReuseInput {
     uint slot;
     uint index;
     Domain domain;
-    float confidence;
 };
 
 // The inputs of the current resampling, 0 the canonical one. A global rather than a parameter:
@@ -95,69 +89,27 @@ ShiftParams reuse_shift_params() {
     return ShiftParams(roughness_threshold, distance_threshold);
 }
 
-// The selected shift of `base` into domain `to`, from another domain (within one domain the shift
-// is the identity, which callers skip); every inverse is the same shift back.
-ShiftResult shift_path(PathRecord base, Domain to) {
+// The selected shift of `record` into domain `to`: with `inverse` false the forward shift T_i of
+// input i's sample into the canonical domain; with `inverse` true T_l^{-1}, which carries a
+// sample of the canonical domain back into input l's domain `to` (the p̂_{<-l} terms of the MIS
+// weights). Within one domain the shift is the identity, which callers skip.
+ShiftResult shift_path(PathRecord record, Domain to, bool inverse) {
     local_shifts_attempted += 1u;
     vec3 camera;
-    Vertex y1;
+    Vertex v1;
     ShiftResult s = shift_failed();
-    if (domain_primary(to, base, camera, y1)) {
+    if (domain_primary(to, record, camera, v1)) {
+        ShiftParams params = reuse_shift_params();
 #if SHIFT_MODE == SHIFT_RECONNECTION
-        s = shift_reconnection(reuse_shift_params(), base, camera, y1);
+        s = inverse ? inverse_reconnection(params, record, camera, v1) : shift_reconnection(params, record, camera, v1);
 #elif SHIFT_MODE == SHIFT_REPLAY
-        s = shift_random_replay(reuse_shift_params(), base, camera, y1);
+        s = inverse ? inverse_random_replay(params, record, camera, v1) : shift_random_replay(params, record, camera, v1);
 #else
-        s = shift_hybrid(reuse_shift_params(), base, camera, y1);
+        s = inverse ? inverse_hybrid(params, record, camera, v1) : shift_hybrid(params, record, camera, v1);
 #endif
     }
     if (!s.valid) local_shifts_failed += 1u;
     return s;
-}
-
-// p̂_{<-l}(y) for the current resampling: [0] p̂(y) of the canonical domain, [i] input i's own
-// p̂ carried back by its Jacobian, [l] p̂_l(T_l^{-1}(y)) |(T_l^{-1})'(y)| (0 where y cannot be
-// shifted into domain l). A global for the reason `inputs` is one.
-float targets_from[MAX_INPUTS];
-
-// m_i(y) for input i's sample shifted to y, from targets_from (twin: gris::mis_weight).
-float mis_weight(uint n, uint i) {
-#if MIS_MODE == MIS_GBH
-    float numerator = inputs[i].confidence * targets_from[i];
-    float total = numerator;
-    if (i != 0u) total += inputs[0].confidence * targets_from[0];
-    for (uint l = 1u; l < n; ++l) {
-        loop_tick();
-        if (l != i) total += inputs[l].confidence * targets_from[l];
-    }
-    return total > 0.0 ? numerator / total : 0.0;
-#else
-    // Defensive pairwise MIS: the canonical input against each neighbour in turn.
-    if (n == 1u) return 1.0;
-    float k = float(n - 1u);
-    float canonical = inputs[0].confidence * targets_from[0] / k;
-    if (i != 0u) {
-        float neighbour = inputs[i].confidence * targets_from[i];
-        return neighbour + canonical > 0.0 ? neighbour / (neighbour + canonical) / (k + 1.0) : 0.0;
-    }
-    float sum = 1.0;
-    for (uint l = 1u; l < n; ++l) {
-        loop_tick();
-        float neighbour = inputs[l].confidence * targets_from[l];
-        sum += neighbour + canonical > 0.0 ? canonical / (neighbour + canonical) : 1.0;
-    }
-    return sum / (k + 1.0);
-#endif
-}
-
-// Whether input i's MIS weight needs p̂_{<-l} of its shifted sample for l >= 1, l != i: every l
-// under the generalized balance heuristic, only the canonical input's under pairwise MIS.
-bool needs_targets_from(uint i) {
-#if MIS_MODE == MIS_GBH
-    return true;
-#else
-    return i == 0u;
-#endif
 }
 
 // Resamples inputs[0..n-1] (0: the canonical pixel's own reservoir) into one reservoir of the
@@ -181,7 +133,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         uint l = step % n;
         bool forward = l == 0u;
         if (forward) {
-            s.confidence += inputs[i].confidence;
+            s.confidence += confidences[i];
             // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
             Reservoir res = input_reservoir(i);
             W = res.W;
@@ -195,7 +147,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         bool wanted = forward || (l != i && needs_targets_from(i));
         bool shift = alive && wanted && !same_domain(from, to);
         ShiftResult shifted = shift_failed();
-        if (shift) shifted = shift_path(y, to);
+        if (shift) shifted = shift_path(y, to, !forward);
         if (forward) {
             if (shift && shifted.valid) {
                 y = shifted.record;

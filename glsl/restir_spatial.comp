@@ -20,7 +20,8 @@ void main() {
         Surface surface = load_surface(surface_slot, pixel);
         if (surface.triangle != NO_HIT) {
             uint seed = path_seed(index, frame_index, render_seed ^ pass_seed);
-            inputs[0] = ReuseInput(in_slot, index, Domain(p, false), canonical.M);
+            inputs[0] = ReuseInput(in_slot, index, Domain(p, false));
+            confidences[0] = canonical.M;
             uint n = 1u;
             for (uint j = 0u; j < min(neighbours, MAX_INPUTS - 1u); ++j) {
                 loop_tick();
@@ -32,7 +33,8 @@ void main() {
                 uint neighbour = uint(q.y) * width + uint(q.x);
                 if (!similar_surfaces(surface, load_surface(surface_slot, neighbour))) continue;
                 uint neighbour_index = reservoir_index(neighbour, layer);
-                inputs[n] = ReuseInput(in_slot, neighbour_index, Domain(uvec2(q), false), load_reservoir(in_slot, neighbour_index).M);
+                inputs[n] = ReuseInput(in_slot, neighbour_index, Domain(uvec2(q), false));
+                confidences[n] = load_reservoir(in_slot, neighbour_index).M;
                 n += 1u;
             }
             vec3 expected;

@@ -48,10 +48,12 @@ void main() {
             reusable = similar_surfaces(surface, load_surface(1u - surface_slot, prev_pixel));
         }
         if (temporal_valid != 0u && reusable) {
-            inputs[0] = ReuseInput(in_slot, index, Domain(p, false), canonical.M);
+            inputs[0] = ReuseInput(in_slot, index, Domain(p, false));
+            confidences[0] = canonical.M;
             uint prev_index = reservoir_index(prev_pixel, layer);
             float confidence = min(load_reservoir(prev_slot, prev_index).M, m_cap * canonical.M);
-            inputs[1] = ReuseInput(prev_slot, prev_index, Domain(uvec2(prev_pixel % width, prev_pixel / width), true), confidence);
+            inputs[1] = ReuseInput(prev_slot, prev_index, Domain(uvec2(prev_pixel % width, prev_pixel / width), true));
+            confidences[1] = confidence;
             vec3 expected;
             result = resample_inputs(2u, path_seed(index, frame_index, render_seed ^ pass_seed), expected);
             expectation[index] = vec4(expected, 0.0);

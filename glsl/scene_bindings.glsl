@@ -29,16 +29,43 @@ const uint FLAG_RUSSIAN_ROULETTE = 1u;
 #ifndef SCENE_UNIFORM_BUFFERS
 #define SCENE_UNIFORM_BUFFERS 0
 #endif
+#ifndef SCENE_ADDRESSED
+#define SCENE_ADDRESSED 0
+#endif
 #if SCENE_UNIFORM_BUFFERS
 layout(std140, set = 0, binding = 1) uniform Triangles { Triangle triangles[SCENE_TRIANGLE_COUNT]; };
 layout(std140, set = 0, binding = 2) uniform Nodes { BvhNode nodes[SCENE_NODE_COUNT]; };
 layout(std140, set = 0, binding = 3) uniform Materials { Material materials[SCENE_MATERIAL_COUNT]; };
 layout(std140, set = 0, binding = 4) uniform Emitters { Emitter emitters[SCENE_EMITTER_SLOTS]; };
+#elif SCENE_ADDRESSED
+// Scenes whose triangles, BVH nodes or emitters exceed one binding's range
+// (maxStorageBufferRange, 128 MiB on lavapipe: about 2.8 M triangles) reach those arrays by
+// buffer device address (GL_EXT_buffer_reference), which is bounded by the allocation size only.
+// Bindings 1, 2 and 4 then hold each array's address and element count; the names below keep
+// `triangles[i]`, `nodes[i]` and `emitters[i]` meaning what they mean in the other layouts.
+#extension GL_EXT_buffer_reference : require
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer TriangleArray { Triangle items[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer NodeArray { BvhNode items[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer EmitterArray { Emitter items[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Triangles { TriangleArray triangle_array; uint triangle_array_length; };
+layout(std430, set = 0, binding = 2) readonly buffer Nodes { NodeArray node_array; uint node_array_length; };
+layout(std430, set = 0, binding = 3) readonly buffer Materials { Material materials[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Emitters { EmitterArray emitter_array; };
+#define triangles (triangle_array.items)
+#define nodes (node_array.items)
+#define emitters (emitter_array.items)
+#define SCENE_TRIANGLES_LENGTH triangle_array_length
+#define SCENE_NODES_LENGTH node_array_length
 #else
 layout(std430, set = 0, binding = 1) readonly buffer Triangles { Triangle triangles[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Nodes { BvhNode nodes[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Materials { Material materials[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Emitters { Emitter emitters[]; };
+#endif
+// The element counts of `triangles` and `nodes`, whatever the layout.
+#ifndef SCENE_TRIANGLES_LENGTH
+#define SCENE_TRIANGLES_LENGTH triangles.length()
+#define SCENE_NODES_LENGTH nodes.length()
 #endif
 
 #endif

@@ -1,5 +1,5 @@
 // Shift mappings of ReSTIR PT in primary sample space: random replay, reconnection and hybrid,
-// with their inverses, on path records. Expects the scene bindings. Twin: src/shift.rs, where
+// with their inverses, on path records. Expects the scene bindings. Twin: src/shading/shift.rs, where
 // the measure, the contribution and the Jacobians are described; docs/shift-mappings.md.
 #ifndef SHIFT_GLSL
 #define SHIFT_GLSL
@@ -59,7 +59,7 @@ struct ShiftResult {
     float jacobian;
     vec3 contribution;
 #ifdef SHIFT_ORACLE
-    // The vertices the shift made (see src/shift.rs), which only the oracle test compares:
+    // The vertices the shift made (see src/shading/shift.rs), which only the oracle test compares:
     // production kernels would copy them on every shift.
     uint vertex_count;
     vec3 vertices[MAX_PATH_LENGTH];
@@ -312,10 +312,6 @@ bool finish_path(inout Path path) {
     }
     path.contribution = c;
     return max_component(c) > 0.0;
-}
-
-bool generate_path(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
-    return trace_vertices(camera, x1, seed, target_length, nee_end, path) && finish_path(path);
 }
 
 struct Link {

@@ -3,7 +3,7 @@
 // llvmpipe runs 8 lanes in lockstep, executes every branch of a loop body under a mask and loads
 // divergent buffer elements one lane and one word at a time, so the cost of a traversal is its
 // loop iterations times the words it loads; a pair shares both (docs/performance.md).
-// Expects the scene buffers (scene_bindings.glsl). Twin: trace_pair in src/bvh.rs.
+// Expects the scene buffers (scene_bindings.glsl). Twin: trace_pair in src/scene/bvh.rs.
 #ifndef TRACE_PAIR_GLSL
 #define TRACE_PAIR_GLSL
 
@@ -28,7 +28,7 @@ void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded)
     occluded = false;
     count_lane(COUNTER_TRAVERSALS);
     uint i = 0u;
-    uint triangle_count = uint(triangles.length());
+    uint triangle_count = uint(SCENE_TRIANGLES_LENGTH);
     for (; i < triangle_count; ++i) {
         loop_tick();
         count_lane(COUNTER_TRIANGLE_TESTS);
@@ -54,7 +54,7 @@ void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded)
     vec3 o_inv_s = shadow.origin * inv_s;
     bool active_c = closest.tmax > 0.0;
     bool active_s = shadow.tmax > 0.0;
-    uint end = nodes.length();
+    uint end = SCENE_NODES_LENGTH;
     uint node = active_c || active_s ? 0u : end;
     while (node < end) {
         loop_tick();

@@ -13,6 +13,8 @@ pub enum GpuError {
     OutOfMemory { what: String, bytes: u64 },
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per storage-buffer binding (maxStorageBufferRange)")]
     BindingTooLarge { what: String, needed: u64, limit: u64 },
+    #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per allocation (maxMemoryAllocationSize)")]
+    AllocationTooLarge { what: String, needed: u64, limit: u64 },
     #[error("Vulkan call failed during {during}: {result:?}")]
     Vulkan { during: &'static str, result: vk::Result },
     #[error("{groups} subgroup(s) of a dispatch ran out of the driver's loop budget ({limit} iterations per loop and shader invocation; about {counted} counted), which truncates paths: the render was stopped rather than written wrong")]

@@ -4,26 +4,12 @@
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod bsdf;
-pub mod bundled_scenes;
-pub mod bvh;
-pub mod charts;
 pub mod cli;
-pub mod environment;
 pub mod error;
-pub mod gltf_writer;
 pub mod gpu_types;
-pub mod gris;
 pub mod image_io;
-pub mod lights;
 pub mod metrics;
-pub mod path_record;
-pub mod ray_offset;
 pub mod render;
-pub mod rng;
-pub mod sampling;
 pub mod scene;
-pub mod shift;
-pub mod surface;
-pub mod texture;
+pub mod shading;
 pub mod vk;

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use serde_json::{json, Value};
 
 /// A floor, a ceiling light and a camera: a valid scene that each case then breaks.

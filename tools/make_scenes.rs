@@ -9,15 +9,15 @@ fn main() -> anyhow::Result<()> {
     if let [flag, levels, out] = &args[..] {
         anyhow::ensure!(flag == "--tiled-floor", "usage: make_scenes [--tiled-floor LEVELS OUT.gltf]");
         let levels: u32 = levels.parse()?;
-        std::fs::write(out, restir_pt::bundled_scenes::tiled_floor(levels))?;
+        std::fs::write(out, restir_pt::scene::bundled_scenes::tiled_floor(levels))?;
         println!(
             "wrote {out} ({} triangles)",
-            (1usize << levels) * restir_pt::bundled_scenes::TILE_TRIANGLES
+            (1usize << levels) * restir_pt::scene::bundled_scenes::TILE_TRIANGLES
         );
         return Ok(());
     }
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    for scene in restir_pt::bundled_scenes::BUNDLED_SCENES {
+    for scene in restir_pt::scene::bundled_scenes::BUNDLED_SCENES {
         let path = dir.join(scene.file_name);
         std::fs::write(&path, (scene.build)()).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
         println!("wrote {}", path.display());

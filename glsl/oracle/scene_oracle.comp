@@ -1,6 +1,6 @@
 #version 460
 // Oracle kernel: BVH traversal, light sampling and camera rays against a real scene
-// (twins: src/bvh.rs, src/ray_offset.rs, src/lights.rs, src/scene/camera.rs), and shadow rays
+// (twins: src/scene/bvh.rs, src/shading/ray_offset.rs, src/shading/lights.rs, src/scene/camera.rs), and shadow rays
 // to punctual lights.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
@@ -26,7 +26,7 @@ void main() {
     Hit h = trace_closest(o.xyz, d, o.w);
     bool occluded = trace_occluded(o.xyz, d, o.w);
     LightSample ls = sample_light(o.xyz, u);
-    uint offset_triangle = i % uint(triangles.length());
+    uint offset_triangle = i % uint(SCENE_TRIANGLES_LENGTH);
     bool shadowed = is_punctual_light(ls.triangle) && punctual_occluded(o.xyz, d, offset_triangle, ls.dir, ls.dist);
     outputs[6u * i + 5u] = vec4(shadowed ? 1.0 : 0.0, 0.0, 0.0, 0.0);
     outputs[6u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);

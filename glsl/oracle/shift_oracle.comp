@@ -1,6 +1,8 @@
 #version 460
-// Oracle kernel: one shift (or its inverse) per item on records the host made
-// (twin: src/shift.rs).
+// Oracle kernel: one shift per item on records the host made, the function ORACLE_SHIFT names
+// (0 to 2: shift_reconnection, shift_random_replay, shift_hybrid; 3 to 5: inverse_reconnection,
+// inverse_random_replay, inverse_hybrid), each compiled alone. Twins: the functions of the same
+// names in src/shading/shift.rs.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
@@ -8,14 +10,15 @@ layout(local_size_x = 64) in;
 #include "../scene_bindings.glsl"
 #include "../shift.glsl"
 
-const uint KIND_RECONNECTION = 0u;
-const uint KIND_RANDOM_REPLAY = 1u;
-const uint KIND_HYBRID = 2u;
+#ifndef ORACLE_SHIFT
+#error "ORACLE_SHIFT names the shift to test"
+#endif
 
-// x: kind, y: roughness threshold, z: distance threshold (float bits), w: unused.
+// x: unused, y: roughness threshold, z: distance threshold (float bits), w: unused.
 layout(std430, set = 0, binding = 5) readonly buffer Params { uvec4 shift_params; };
 layout(std430, set = 0, binding = 6) readonly buffer Records { PathRecord records[]; };
-// Per item: target primary hit position (w: triangle bits), camera position.
+// Per item: the target domain's primary hit position (w: triangle bits; the base's x1 for an
+// inverse), its camera position.
 layout(std430, set = 0, binding = 7) readonly buffer Targets { vec4 targets[]; };
 // Per item, 13 vec4: (valid, jacobian, vertex count, 0), the record (5 vec4), the vertices (7 vec4).
 layout(std430, set = 0, binding = 8) writeonly buffer Outputs { vec4 outputs[]; };
@@ -28,13 +31,22 @@ void main() {
     if (i >= count) return;
     ShiftParams params = ShiftParams(uintBitsToFloat(shift_params.y), uintBitsToFloat(shift_params.z));
     vec4 target = targets[2u * i];
-    Vertex y1 = vertex_on_surface(floatBitsToUint(target.w), target.xyz);
+    Vertex v1 = vertex_on_surface(floatBitsToUint(target.w), target.xyz);
     vec3 camera = targets[2u * i + 1u].xyz;
-    PathRecord base = records[i];
-    ShiftResult s;
-    if (shift_params.x == KIND_RECONNECTION) s = shift_reconnection(params, base, camera, y1);
-    else if (shift_params.x == KIND_RANDOM_REPLAY) s = shift_random_replay(params, base, camera, y1);
-    else s = shift_hybrid(params, base, camera, y1);
+    PathRecord record = records[i];
+#if ORACLE_SHIFT == 0
+    ShiftResult s = shift_reconnection(params, record, camera, v1);
+#elif ORACLE_SHIFT == 1
+    ShiftResult s = shift_random_replay(params, record, camera, v1);
+#elif ORACLE_SHIFT == 2
+    ShiftResult s = shift_hybrid(params, record, camera, v1);
+#elif ORACLE_SHIFT == 3
+    ShiftResult s = inverse_reconnection(params, record, camera, v1);
+#elif ORACLE_SHIFT == 4
+    ShiftResult s = inverse_random_replay(params, record, camera, v1);
+#else
+    ShiftResult s = inverse_hybrid(params, record, camera, v1);
+#endif
     uint o = OUT_STRIDE * i;
     outputs[o] = vec4(s.valid ? 1.0 : 0.0, s.jacobian, float(s.vertex_count), 0.0);
     PathRecord r = s.record;

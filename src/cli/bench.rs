@@ -8,22 +8,41 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 use serde::Serialize;
 
-use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use clap::Args;
+
+use super::args::{DeviceArgs, SceneArgs, SizeArgs, Toggle};
+use super::{finish_device, load_with_options, open_device};
 use crate::metrics::median;
 use crate::render::{PathTracer, RenderSettings, TraversalCounters};
 use crate::scene::Scene;
 
+/// `restir-pt bench`.
+#[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
-    pub scene: Option<PathBuf>,
-    pub width: u32,
-    pub height: u32,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub size: SizeArgs,
+    /// Samples per pixel of each run.
+    #[arg(long, default_value_t = 16)]
     pub spp: u32,
+    /// Maximum number of path segments, as in `render`.
+    #[arg(long, default_value_t = RenderSettings::DEFAULT_MAX_DEPTH)]
     pub max_depth: u32,
+    /// Russian roulette from the third segment on, as in `render`.
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    pub russian_roulette: Toggle,
+    /// Timed runs after one warm-up run.
+    #[arg(long, default_value_t = 5)]
     pub runs: u32,
-    pub russian_roulette: bool,
-    /// Compile the kernel with traversal counters (slower) and report them instead of timing alone.
+    /// Count rays, BVH node visits, triangle tests and SIMD lane use in the kernel (slower:
+    /// a profile, not a timing).
+    #[arg(long)]
     pub counters: bool,
+    /// Write the figures as JSON to this file.
+    #[arg(long)]
     pub report: Option<PathBuf>,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -104,14 +123,14 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     // CPU time before bench() (argument parsing, loader start-up) belongs to the process too.
     whole.cpu = 0.0;
     let mut lap = Stopwatch::start();
-    let path = scene_path(args.scene.as_deref());
-    let scene = load_with_warnings(&path)?;
+    let path = args.scene.path();
+    let scene = load_with_options(&path, &args.scene.load_options(None))?;
     let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
+        width: args.size.width,
+        height: args.size.height,
         spp: args.spp,
         max_depth: args.max_depth,
-        russian_roulette: args.russian_roulette,
+        russian_roulette: args.russian_roulette.on(),
         ..Default::default()
     };
     settings.validate(&scene)?;

@@ -8,38 +8,55 @@ use std::path::PathBuf;
 use anyhow::{bail, Context as _, Result};
 use glam::Vec3;
 
+use clap::Args;
+
+use super::args::{DeviceArgs, PathArgs, RestirArgs, SweepArgs};
 use super::compare_outputs::write_outputs;
-use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
+use super::method_spec::{parse_methods, MethodRenderer, MethodSpec, DEFAULT_METHODS};
 use super::reference_record::check_reference;
 use super::sweep::SweepMode;
-use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use super::{finish_device, load_with_warnings, open_device, scene_path};
 use crate::image_io::read_exr;
 use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};
-use crate::render::{Image, RenderSettings, RestirSettings, MAX_RESERVOIRS};
+use crate::render::{Image, RenderSettings, MAX_RESERVOIRS};
 use crate::scene::{camera_on_path, Scene};
 
+/// `restir-pt compare`.
+#[derive(Args, Debug, Clone)]
 pub struct CompareArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
     pub scene: PathBuf,
+    /// Path-traced reference EXR (see `reference`); it sets the resolution.
+    #[arg(long)]
     pub reference: PathBuf,
+    /// Methods: pt, restir:reconnection, restir:replay, restir:hybrid (optionally /gbh or /pairwise).
+    #[arg(long, value_delimiter = ',', default_value = DEFAULT_METHODS)]
     pub methods: Vec<String>,
-    /// GPU ms per frame; empty: ReSTIR PT's one-reservoir frame cost times 1, 2 and 4.
+    /// GPU ms per frame (default: ReSTIR PT's cheapest frame times 1.05, 2.1 and 4.2). Each method
+    /// spends a budget on path-tracer spp or ReSTIR PT reservoirs per pixel (each with --candidates paths).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     pub budgets_ms: Vec<f64>,
-    /// Frames per run; the error is the last frame's.
+    /// Frames per run; the error is measured on the last frame alone.
+    #[arg(long, default_value_t = 16)]
     pub frames: u32,
-    /// The camera moves along the scene's camera path (`camera_on_path`) instead of staying at
-    /// `camera`; the reference is then of the last frame's camera.
+    /// Move the camera along the scene's camera path from --camera (as `render --frames` does)
+    /// instead of keeping it still; --reference must then be of the last frame's camera, which
+    /// the command prints.
+    #[arg(long)]
     pub camera_path: bool,
-    /// Independent runs per method and budget; errors are averaged, times are medians.
+    /// Independent runs per method and budget (errors averaged, times median).
+    #[arg(long, default_value_t = 1)]
     pub trials: u32,
-    pub max_depth: u32,
-    pub camera: usize,
-    pub seed: u32,
-    pub restir: RestirSettings,
+    #[command(flatten)]
+    pub path: PathArgs,
+    #[command(flatten)]
+    pub restir: RestirArgs,
+    /// Folder for results.csv, the charts and equal_time.png.
+    #[arg(long, default_value = "out/compare")]
     pub out_dir: PathBuf,
-    /// One process for everything, or a job list, one job of it, or the merge of its jobs.
-    pub sweep: SweepMode,
-    /// The command line after `restir-pt` (for the job list's commands).
-    pub argv: Vec<String>,
+    #[command(flatten)]
+    pub sweep: SweepArgs,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -249,14 +266,14 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
             i as u32 / width
         );
     }
-    let methods = parse_methods(&args.methods, &args.restir)?;
+    let methods = parse_methods(&args.methods, &args.restir.settings())?;
     let settings = RenderSettings {
         width,
         height,
         spp: 1,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        camera: args.camera,
+        max_depth: args.path.max_depth,
+        seed: args.path.seed,
+        camera: args.path.camera,
         ..Default::default()
     };
     settings.validate(&scene)?;
@@ -267,9 +284,9 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     }
     // The error is measured on the last frame, seen from this camera.
     let last_camera = if args.camera_path {
-        camera_on_path(args.camera, args.frames - 1, scene.cameras.len())
+        camera_on_path(args.path.camera, args.frames - 1, scene.cameras.len())
     } else {
-        args.camera
+        args.path.camera
     };
     let reference_spp = check_reference(&args.reference, &path, last_camera)?.map(|r| r.spp);
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
@@ -289,8 +306,9 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
 /// With `args.sweep` other than `All`, writes the job list, runs one job, or merges the jobs'
 /// results instead (compare_sweep.rs).
 pub fn compare(args: CompareArgs) -> Result<Vec<CompareRow>> {
+    let mode = args.sweep.mode()?;
     let setup = setup(&args)?;
-    match &args.sweep {
+    match &mode {
         SweepMode::All => compare_all(&args, &setup),
         mode => super::compare_sweep::compare_sweep(&args, &setup, mode),
     }
@@ -391,7 +409,7 @@ pub(super) fn measure(
     let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
     let mut last = None;
     for t in 0..args.trials {
-        let seq = run.sequence(renderer, args.frames, args.seed.wrapping_add(1 + t))?;
+        let seq = run.sequence(renderer, args.frames, args.path.seed.wrapping_add(1 + t))?;
         times.push(seq.gpu_ms_per_frame);
         rel += rel_mse(&seq.last_frame.mean, reference) / args.trials as f64;
         trimmed += rel_mse_trimmed(&seq.last_frame.mean, reference, TRIMMED_SHARE) / args.trials as f64;

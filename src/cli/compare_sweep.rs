@@ -37,7 +37,7 @@ pub(super) fn compare_sweep(args: &CompareArgs, setup: &Setup, mode: &SweepMode)
     match mode {
         SweepMode::All => unreachable!("compare runs All itself"),
         SweepMode::Plan(plan) => {
-            write_plan(plan, &args.argv, &labels, &args.out_dir)?;
+            write_plan(plan, &super::args::argv(), &labels, &args.out_dir)?;
             Ok(vec![])
         }
         SweepMode::Job(k) => run_job(args, setup, *k, &labels),

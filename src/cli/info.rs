@@ -3,30 +3,49 @@
 use std::path::Path;
 
 use anyhow::Result;
+use clap::Args;
 use glam::Vec3;
 
-use super::{finish_device, load_with_options, open_device, DeviceArgs};
-use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings};
-use crate::scene::LoadOptions;
+use super::args::{DeviceArgs, RestirArgs, SceneArgs};
+use super::{finish_device, load_with_options, open_device};
+use crate::render::{PathTracer, RenderSettings, Restir};
+use crate::scene::Scene;
 use crate::vk::KernelCompile;
 
 /// Materials listed one per line; vertex colours can make thousands of variants.
 const MAX_LISTED_MATERIALS: usize = 64;
 
-/// Prints what `path` (loaded with `options`) contains and how long the load took; with
-/// `kernels`, also builds the scene's kernels (the path tracer's and ReSTIR PT's with the given
-/// settings) on the device and prints their costs.
-pub fn info(path: &Path, options: &LoadOptions, kernels: Option<(RestirSettings, DeviceArgs)>) -> Result<()> {
+/// `restir-pt info`.
+#[derive(Args, Debug, Clone)]
+pub struct InfoArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Also build every kernel of the path tracer and of ReSTIR PT (with the shift and MIS
+    /// given) and print its SPIR-V size and compile time per stage.
+    #[arg(long)]
+    pub kernels: bool,
+    #[command(flatten)]
+    pub restir: RestirArgs,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+/// Prints what the scene contains and how long the load took; with --kernels, also builds the
+/// scene's kernels (the path tracer's and ReSTIR PT's with the given settings) on the device
+/// and prints their costs.
+pub fn info(args: InfoArgs) -> Result<()> {
+    let path = args.scene.path();
     let start = std::time::Instant::now();
-    let scene = load_with_options(path, options)?;
+    let scene = load_with_options(&path, &args.scene.load_options(None))?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
-    print_scene(path, &scene, load_ms);
-    if let Some((restir, device)) = kernels {
-        let ctx = open_device(&device)?;
+    print_scene(&path, &scene, load_ms);
+    if args.kernels {
+        let restir = args.restir.settings();
+        let ctx = open_device(&args.device)?;
         let settings = RenderSettings {
             width: 8,
             height: 8,
-            max_depth: crate::path_record::MAX_PATH_LENGTH as u32,
+            max_depth: crate::shading::path_record::MAX_PATH_LENGTH as u32,
             ..Default::default()
         };
         let mut reports = vec![PathTracer::new(&ctx, &scene, &settings)?.compile_report().clone()];
@@ -56,7 +75,19 @@ fn print_kernels(label: &str, reports: &[KernelCompile]) {
     println!("  all kernels: {total:.0} ms");
 }
 
-fn print_scene(path: &Path, scene: &crate::scene::Scene, load_ms: f64) {
+/// Triangles of each material, by material index: materials of equal parameters (two glTF
+/// materials alike, or a material and its vertex-colour variant of colour 1) count apart.
+pub fn triangles_per_material(scene: &Scene) -> Vec<usize> {
+    let mut uses = vec![0usize; scene.materials.len()];
+    for t in &scene.triangles {
+        if let Some(u) = uses.get_mut(t.material as usize) {
+            *u += 1;
+        }
+    }
+    uses
+}
+
+fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
     let (lo, hi) = scene.bounds;
     println!("scene: {}", path.display());
     println!("triangles: {}", scene.triangles.len());
@@ -65,6 +96,9 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene, load_ms: f64) {
         scene.build_ms
     );
     println!("BVH nodes: {}", scene.nodes.len());
+    if let Some(line) = scene.surface_summary() {
+        println!("{line}");
+    }
     println!(
         "emitters: {} triangles, power {:.4} (luminance W)",
         scene.emitters.len(),
@@ -95,13 +129,11 @@ fn print_scene(path: &Path, scene: &crate::scene::Scene, load_ms: f64) {
         );
     }
     println!("materials: {}", scene.materials.len());
-    let mut uses = vec![0usize; scene.materials.len()];
-    scene.triangles.iter().for_each(|t| uses[t.material as usize] += 1);
     for ((m, name), used) in scene
         .materials
         .iter()
         .zip(&scene.material_names)
-        .zip(uses)
+        .zip(triangles_per_material(scene))
         .take(MAX_LISTED_MATERIALS)
     {
         println!(

@@ -72,6 +72,9 @@ impl MethodSpec {
     }
 }
 
+/// `--methods` of `compare` and `stability` by default: the path tracer and every shift.
+pub const DEFAULT_METHODS: &str = "pt,restir:reconnection,restir:replay,restir:hybrid";
+
 /// Parses a comma-separated method list.
 pub fn parse_methods(list: &[String], base: &RestirSettings) -> Result<Vec<MethodSpec>> {
     if list.is_empty() {

@@ -1,6 +1,10 @@
-//! The commands behind the CLI; main.rs only parses arguments into these structs.
+//! The commands behind the CLI. Each command's options are declared once, as the clap struct
+//! its function takes (`RenderArgs` for `render`, ...); options several commands share are
+//! groups in args.rs. main.rs only parses and dispatches.
 
+mod args;
 mod bench;
+pub mod charts;
 mod compare;
 mod compare_outputs;
 mod compare_sweep;
@@ -10,19 +14,22 @@ mod profile;
 mod reference;
 mod reference_record;
 mod render;
+mod render_output;
 mod shard;
 mod stability;
 mod sweep;
 
+pub use args::{parse_args, DeviceArgs, EnvArg, PathArgs, RestirArgs, SceneArgs, SizeArgs, SweepArgs, Toggle};
 pub use bench::{bench, BenchArgs};
 pub use compare::{compare, CompareArgs, CompareRow};
 pub use compare_outputs::equal_time_lines;
-pub use info::info;
-pub use method_spec::MethodSpec;
+pub use info::{info, triangles_per_material, InfoArgs};
+pub use method_spec::{MethodSpec, DEFAULT_METHODS};
 pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
-pub use render::{render, Method, RenderArgs};
-pub use shard::{merge, merge_shards, read_shard, ShardMeta, ShardSpec, ShardSums};
+pub use render::{render, MethodArg, RenderArgs};
+pub use render_output::{RenderReport, RestirFrameReport};
+pub use shard::{merge, merge_shards, read_shard, MergeArgs, ShardMeta, ShardSpec, ShardSums};
 pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
 pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
 
@@ -35,12 +42,6 @@ use crate::scene::{collapse_warnings, load_scene_reporting, LoadOptions, Scene};
 use crate::vk::{Context, ContextOptions};
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell.gltf";
-
-#[derive(Debug, Clone, Default)]
-pub struct DeviceArgs {
-    pub device: Option<String>,
-    pub validate: bool,
-}
 
 /// The scene to load: the given path, or the bundled Cornell box.
 pub fn scene_path(scene: Option<&Path>) -> PathBuf {
@@ -79,7 +80,8 @@ pub fn load_with_options(path: &Path, options: &LoadOptions) -> Result<Scene> {
 pub fn open_device(args: &DeviceArgs) -> Result<Arc<Context>> {
     let ctx = Context::new(&ContextOptions {
         device: args.device.clone(),
-        validation: args.validate,
+        validation: args.validation(),
+        ..Default::default()
     })?;
     eprintln!("device: {} ({:?})", ctx.info.name, ctx.info.device_type);
     Ok(Arc::new(ctx))

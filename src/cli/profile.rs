@@ -3,26 +3,41 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{bail, Context as _, Result};
+use clap::Args;
 
-use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use super::args::{DeviceArgs, PathArgs, RestirArgs, SceneArgs, SizeArgs};
+use super::render_output::{compile_progress, print_compile_summary};
+use super::{finish_device, load_with_options, open_device};
 use crate::metrics::quantile;
 use crate::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
-use crate::scene::camera_on_path;
+use crate::scene::{camera_on_path, Scene};
+use crate::vk::Context;
 
+/// `restir-pt profile`.
+#[derive(Args, Debug, Clone)]
 pub struct ProfileArgs {
-    pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Frames to time (a static camera unless --camera-path); kernels are compiled before them.
+    #[arg(long, default_value_t = 16)]
     pub frames: u32,
-    pub width: u32,
-    pub height: u32,
-    pub max_depth: u32,
-    pub camera: usize,
-    /// Frames move along the scene's camera path from `camera` (`camera_on_path`); otherwise
-    /// they are accumulated from `camera`.
+    #[command(flatten)]
+    pub size: SizeArgs,
+    #[command(flatten)]
+    pub path: PathArgs,
+    /// Move the camera along the scene's camera path from --camera instead of accumulating
+    /// frames of an unmoved one.
+    #[arg(long)]
     pub camera_path: bool,
-    pub restir: RestirSettings,
+    #[command(flatten)]
+    pub restir: RestirArgs,
+    /// Folder for passes.csv, trace.json and passes.svg.
+    #[arg(long, default_value = "out/profile")]
     pub out_dir: PathBuf,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -99,56 +114,76 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let path = scene_path(args.scene.as_deref());
-    let scene = load_with_warnings(&path)?;
+    let path = args.scene.path();
+    let scene = load_with_options(&path, &args.scene.load_options(None))?;
     let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
-        max_depth: args.max_depth,
-        camera: args.camera,
+        width: args.size.width,
+        height: args.size.height,
+        max_depth: args.path.max_depth,
+        camera: args.path.camera,
+        seed: args.path.seed,
         ..Default::default()
     };
     settings.validate(&scene)?;
-    args.restir.validate(settings.max_depth)?;
+    let restir = args.restir.settings();
+    restir.validate(settings.max_depth)?;
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     let ctx = open_device(&args.device)?;
+    let times = pass_times(&ctx, &scene, &settings, &restir, &args)?;
+    finish_device(&ctx)?;
+    let motion = if args.camera_path { "moving camera" } else { "static camera" };
+    let title = format!(
+        "{} {} {}x{}, {motion}, on {}",
+        path.display(),
+        restir.label(),
+        settings.width,
+        settings.height,
+        ctx.info.name
+    );
+    write_outputs(&args, &times, &title)
+}
+
+/// Every frame's GPU ms per pass.
+fn pass_times(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    settings: &RenderSettings,
+    restir: &RestirSettings,
+    args: &ProfileArgs,
+) -> Result<Vec<[f64; 4]>> {
     if !ctx.info.timestamps_supported {
         bail!("{}: the device has no compute timestamps to profile with", ctx.info.name);
     }
-    let spinner = super::render::compile_progress();
-    let mut renderer = Restir::with_progress(&ctx, &scene, &settings, &args.restir, &|name| spinner.set_message(name.to_string()))?;
+    let spinner = compile_progress();
+    let mut renderer = Restir::with_progress(ctx, scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
     spinner.finish_and_clear();
-    super::render::print_compile_summary(&renderer.compile_reports());
+    print_compile_summary(&renderer.compile_reports());
     let mut times = vec![];
     for f in 0..args.frames {
         let stats = if args.camera_path {
-            renderer.frame(&scene, camera_on_path(args.camera, f, scene.cameras.len()), false)?
+            renderer.frame(scene, camera_on_path(args.path.camera, f, scene.cameras.len()), false)?
         } else {
-            renderer.frame(&scene, args.camera, true)?
+            renderer.frame(scene, args.path.camera, true)?
         };
-        times.push(stats.pass_ms.expect("timestamps are supported"));
+        let Some(ms) = stats.pass_ms else {
+            bail!("{}: a frame came back without pass times", ctx.info.name);
+        };
+        times.push(ms);
     }
-    drop(renderer);
-    finish_device(&ctx)?;
+    Ok(times)
+}
 
+/// passes.csv, trace.json, passes.svg and the median/p95 table.
+fn write_outputs(args: &ProfileArgs, times: &[[f64; 4]], title: &str) -> Result<()> {
     let mut csv = String::from("frame,pass,gpu_ms\n");
     for (f, t) in times.iter().enumerate() {
         for (p, ms) in t.iter().enumerate() {
             let _ = writeln!(csv, "{f},{},{ms:.4}", PASS_NAMES[p]);
         }
     }
-    let motion = if args.camera_path { "moving camera" } else { "static camera" };
-    let title = format!(
-        "{} {} {}x{}, {motion}, on {}",
-        path.display(),
-        args.restir.label(),
-        args.width,
-        args.height,
-        ctx.info.name
-    );
     write(&args.out_dir.join("passes.csv"), &csv)?;
-    write(&args.out_dir.join("trace.json"), &serde_json::to_string(&chrome_trace(&times))?)?;
-    write(&args.out_dir.join("passes.svg"), &stacked_bar_svg(&times, &title))?;
+    write(&args.out_dir.join("trace.json"), &serde_json::to_string(&chrome_trace(times))?)?;
+    write(&args.out_dir.join("passes.svg"), &stacked_bar_svg(times, title))?;
     println!("{title}, {} frames: GPU ms per pass", args.frames);
     println!("{:<10} {:>10} {:>10}", "pass", "median", "p95");
     for (p, name) in PASS_NAMES.iter().enumerate() {

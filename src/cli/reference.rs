@@ -1,30 +1,42 @@
 //! `restir-pt reference`: a converged path-traced mean and its variance, in short submissions.
 
-use std::path::PathBuf;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
+use clap::Args;
 
+use super::args::{DeviceArgs, PathArgs, SizeArgs};
 use super::reference_record::{scene_name, write_record, ReferenceRecord};
-use super::render::{interrupt_flag, progress_bar};
+use super::render_output::{create_parent, interrupt_flag, progress_bar};
 use super::shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
-use super::{finish_device, load_with_warnings, open_device, scene_path, DeviceArgs};
+use super::{finish_device, load_with_warnings, open_device, scene_path};
 use crate::image_io::write_exr;
-use crate::render::{PathTracer, RenderSettings};
+use crate::render::{Image, PathTracer, RenderSettings, RenderStats};
 
+/// `restir-pt reference`.
+#[derive(Args, Debug, Clone)]
 pub struct ReferenceArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
     pub scene: PathBuf,
+    /// Samples per pixel of the whole reference (of all shards together with --shard).
+    #[arg(long, default_value_t = 4096)]
     pub spp: u32,
-    pub width: u32,
-    pub height: u32,
-    pub max_depth: u32,
-    pub camera: usize,
-    pub seed: u32,
+    #[command(flatten)]
+    pub size: SizeArgs,
+    #[command(flatten)]
+    pub path: PathArgs,
+    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    #[arg(long)]
     pub out: PathBuf,
-    /// Write a reference with non-finite pixels (with a warning) instead of failing.
+    /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
+    #[arg(long)]
     pub allow_nonfinite: bool,
-    /// Render only this share of the `spp` samples and write their sums to `out` (a shard EXR,
-    /// see `shard.rs`) instead of the mean and variance.
-    pub shard: Option<ShardSpec>,
+    /// Render only share I of N (0-based) of the --spp samples, disjoint from the other shares,
+    /// and write their per-pixel sums to --out as a shard EXR for `merge`.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -34,27 +46,28 @@ pub fn variance_path(out: &std::path::Path) -> PathBuf {
 }
 
 pub fn reference(args: ReferenceArgs) -> Result<()> {
+    let shard = args.shard.as_deref().map(ShardSpec::parse).transpose()?;
     let path = scene_path(Some(&args.scene));
     let scene = load_with_warnings(&path)?;
-    let samples = args.shard.map(|s| s.samples(args.spp)).unwrap_or(0..args.spp);
+    let samples = shard.map(|s| s.samples(args.spp)).unwrap_or(0..args.spp);
     if samples.is_empty() {
         bail!(
             "--spp {} cannot be cut into {} shards: each needs at least 1 sample",
             args.spp,
-            args.shard.map_or(1, |s| s.count)
+            shard.map_or(1, |s| s.count)
         );
     }
     let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
+        width: args.size.width,
+        height: args.size.height,
         spp: samples.len() as u32,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        camera: args.camera,
+        max_depth: args.path.max_depth,
+        seed: args.path.seed,
+        camera: args.path.camera,
         ..Default::default()
     };
     settings.validate(&scene)?;
-    super::render::create_parent(&args.out)?;
+    create_parent(&args.out)?;
     let ctx = open_device(&args.device)?;
     let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
     tracer.start_at_sample(samples.start);
@@ -73,58 +86,87 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
         }
         eprintln!("warning: {what}; writing the reference anyway (--allow-nonfinite)");
     }
-    let variance = variance_path(&args.out);
-    if let Some(shard) = args.shard {
-        let (sums, sums_sq) = tracer.sums()?;
-        let meta = ShardMeta {
-            scene: path.display().to_string(),
-            width: settings.width,
-            height: settings.height,
-            max_depth: settings.max_depth,
-            camera: settings.camera,
-            seed: settings.seed,
-            total_spp: args.spp,
-            shard: shard.index,
-            shards: shard.count,
-            first_sample: samples.start,
-            spp: stats.spp,
-        };
-        write_shard(&args.out, &ShardSums { meta, sums, sums_sq })?;
-    } else {
-        write_exr(&args.out, image.width, image.height, &image.mean)?;
-        write_exr(&variance, image.width, image.height, &image.variance)?;
-        let record = ReferenceRecord {
-            scene: scene_name(&path),
-            camera: settings.camera,
-            width: image.width,
-            height: image.height,
-            spp: stats.spp,
-        };
-        write_record(&args.out, &record)?;
-    }
+    let written = Written {
+        path: &path,
+        settings: &settings,
+        stats: &stats,
+        samples,
+        shard,
+    };
+    written.write(&args, &tracer, &image)?;
     drop(tracer);
     finish_device(&ctx)?;
-    println!(
-        "reference {} | {}x{} | {} spp | depth {} | GPU {:.1} ms{}",
-        path.display(),
-        settings.width,
-        settings.height,
-        stats.spp,
-        settings.max_depth,
-        stats.gpu_ms,
-        if stats.interrupted { " | interrupted" } else { "" }
-    );
-    match args.shard {
-        Some(s) => eprintln!(
-            "wrote shard {}/{} (samples {}..{} of {}) to {}",
-            s.index,
-            s.count,
-            samples.start,
-            samples.end,
-            args.spp,
-            args.out.display()
-        ),
-        None => eprintln!("wrote {} and {}", args.out.display(), variance.display()),
-    }
+    written.print(&args);
     Ok(())
+}
+
+/// What a reference run rendered, to be written as a reference or a shard.
+struct Written<'a> {
+    path: &'a Path,
+    settings: &'a RenderSettings,
+    stats: &'a RenderStats,
+    samples: Range<u32>,
+    shard: Option<ShardSpec>,
+}
+
+impl Written<'_> {
+    /// The shard's sums, or the mean, variance and record of a whole reference.
+    fn write(&self, args: &ReferenceArgs, tracer: &PathTracer, image: &Image) -> Result<()> {
+        let (path, settings, stats) = (self.path, self.settings, self.stats);
+        if let Some(shard) = self.shard {
+            let (sums, sums_sq) = tracer.sums()?;
+            let meta = ShardMeta {
+                scene: path.display().to_string(),
+                width: settings.width,
+                height: settings.height,
+                max_depth: settings.max_depth,
+                camera: settings.camera,
+                seed: settings.seed,
+                total_spp: args.spp,
+                shard: shard.index,
+                shards: shard.count,
+                first_sample: self.samples.start,
+                spp: stats.spp,
+            };
+            write_shard(&args.out, &ShardSums { meta, sums, sums_sq })
+        } else {
+            write_exr(&args.out, image.width, image.height, &image.mean)?;
+            write_exr(&variance_path(&args.out), image.width, image.height, &image.variance)?;
+            let record = ReferenceRecord {
+                scene: scene_name(path),
+                camera: settings.camera,
+                width: image.width,
+                height: image.height,
+                spp: stats.spp,
+            };
+            write_record(&args.out, &record)
+        }
+    }
+
+    /// The summary line and what was written where.
+    fn print(&self, args: &ReferenceArgs) {
+        let (settings, stats) = (self.settings, self.stats);
+        println!(
+            "reference {} | {}x{} | {} spp | depth {} | GPU {:.1} ms{}",
+            self.path.display(),
+            settings.width,
+            settings.height,
+            stats.spp,
+            settings.max_depth,
+            stats.gpu_ms,
+            if stats.interrupted { " | interrupted" } else { "" }
+        );
+        match self.shard {
+            Some(s) => eprintln!(
+                "wrote shard {}/{} (samples {}..{} of {}) to {}",
+                s.index,
+                s.count,
+                self.samples.start,
+                self.samples.end,
+                args.spp,
+                args.out.display()
+            ),
+            None => eprintln!("wrote {} and {}", args.out.display(), variance_path(&args.out).display()),
+        }
+    }
 }

@@ -2,208 +2,174 @@
 //! summary per frame.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use anyhow::{bail, Context as _, Result};
-use serde::Serialize;
+use clap::{Args, ValueEnum};
 
-use super::{finish_device, load_with_options, open_device, scene_path, DeviceArgs};
-use crate::image_io::{exposure_ev, write_exr, write_png_exposed, Exposure};
-use crate::render::{FrameStats, PathTracer, RenderSettings, Restir, RestirSettings, PASS_NAMES};
-use crate::scene::{camera_on_path, LoadOptions, Scene};
+use super::args::{parse_exposure, DeviceArgs, PathArgs, RestirArgs, SceneArgs, Toggle};
+use super::render_output::{
+    compile_progress, create_parent, guard_nonfinite, interrupt_flag, print_compile_summary, progress_bar, Outputs, RenderReport,
+    RestirFrameReport,
+};
+use super::{finish_device, load_with_options, open_device};
+use crate::image_io::Exposure;
+use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings};
+use crate::scene::{camera_on_path, Scene};
+use crate::vk::Context;
 
-/// The rendering method: the path tracer, or ReSTIR PT with its settings.
-#[derive(Debug, Clone)]
-pub enum Method {
-    PathTracing,
-    Restir(RestirSettings),
+/// The rendering method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Unidirectional path tracing with NEE and MIS.
+    Pt,
+    /// ReSTIR PT: resampled paths reused across pixels and frames through shift mappings.
+    Restir,
 }
 
+/// `restir-pt render`.
+#[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    pub scene: Option<PathBuf>,
-    pub method: Method,
-    /// Paths per pixel of the path tracer (default 64); ReSTIR PT renders frames instead.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[arg(long, value_enum, default_value_t = MethodArg::Restir)]
+    pub method: MethodArg,
+    /// Path-tracer samples per pixel (default 64); only with --method pt. With --static-camera
+    /// and --frames F, each frame adds this many and the image holds all F times as many.
+    #[arg(long)]
     pub spp: Option<u32>,
-    /// Every frame from --camera, averaged (ReSTIR PT's offline mode).
-    pub static_camera: bool,
-    /// Image sides; a missing one follows the camera's aspect ratio (`Camera::image_size`).
+    /// Image width; with --height alone it follows the camera's aspectRatio (default 256).
+    #[arg(long)]
     pub width: Option<u32>,
+    /// Image height; with --width alone it follows the camera's aspectRatio (default 256).
+    #[arg(long)]
     pub height: Option<u32>,
-    pub max_depth: u32,
-    pub seed: u32,
-    pub russian_roulette: bool,
-    pub camera: usize,
-    pub frames: u32,
-    pub out_dir: Option<PathBuf>,
-    pub out: Option<PathBuf>,
-    pub png: Option<PathBuf>,
-    pub variance: Option<PathBuf>,
-    pub report: Option<PathBuf>,
-    /// Write images with non-finite pixels (with a warning) instead of failing.
-    pub allow_nonfinite: bool,
-    /// What to load besides the file: `--scene N`, `--env`.
-    pub load: LoadOptions,
-    /// Exposure of the PNG previews.
+    /// PNG preview exposure: EV (radiance times 2^EV) or auto (log-average luminance to 0.18,
+    /// so that an evenly lit scene shows mid-grey whatever its radiance). The EXR is never
+    /// changed.
+    #[arg(long, default_value = "auto", value_parser = parse_exposure, allow_hyphen_values = true)]
     pub exposure: Exposure,
+    #[command(flatten)]
+    pub path: PathArgs,
+    /// Russian roulette from the third segment on (survival = max throughput, at most 0.95);
+    /// path tracer only, default on (ReSTIR PT does not use it: it traces every path to
+    /// --max-depth).
+    #[arg(long, value_enum)]
+    pub russian_roulette: Option<Toggle>,
+    /// Render F frames along the scene's camera path from --camera: its cameras in order, then
+    /// back and forth (0, 1, ..., n-1, n-2, ..., 0, 1, ...). The last frame goes to --out;
+    /// every frame too with --out-dir.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+    /// Render every frame from --camera and write the average of the frames (offline mode).
+    #[arg(long)]
+    pub static_camera: bool,
+    #[command(flatten)]
+    pub restir: RestirArgs,
+    /// Folder for every frame of --frames (frame_0000.exr/png, ...).
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Linear float RGB EXR output (default: out/<scene>.exr).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Tonemapped sRGB PNG preview (default: next to the EXR).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Also write the per-pixel variance of the estimate as an EXR.
+    #[arg(long)]
+    pub variance: Option<PathBuf>,
+    /// Write the summary as JSON, with every frame's GPU time and their median.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Write images that have NaN or infinite pixels (with a warning); without it such an
+    /// image is not written and the exit code is 1.
+    #[arg(long)]
+    pub allow_nonfinite: bool,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
-#[derive(Serialize)]
-pub struct RenderReport {
-    pub device: String,
-    pub scene: String,
-    pub method: String,
-    pub width: u32,
-    pub height: u32,
-    pub spp: u32,
-    pub max_depth: u32,
-    pub gpu_ms: f64,
-    pub wall_ms: f64,
-    pub paths_per_second: f64,
-    /// Start-up milliseconds spent compiling the kernels (outside every frame's time).
-    pub compile_ms: f64,
-    /// NaN or infinite pixels of the image written (or refused) for this frame.
-    pub nonfinite_pixels: usize,
-    /// Path weights found NaN or infinite: the path tracer's paths with a non-finite radiance or
-    /// throughput over the whole render; ReSTIR PT's candidate and shift weights of this frame.
-    pub nonfinite_weights: u64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub restir: Option<RestirFrameReport>,
-}
-
-/// A spinner that names the kernel being compiled; compiling takes seconds on llvmpipe.
-pub(super) fn compile_progress() -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_style(indicatif::ProgressStyle::with_template("{spinner} compiling {msg}  {elapsed}").expect("static template is valid"));
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    bar
-}
-
-/// The start-up line: how long compiling the kernels took.
-pub(super) fn print_compile_summary(kernels: &[crate::vk::KernelCompile]) {
-    let total: f64 = kernels.iter().map(|k| k.total_ms()).sum();
-    eprintln!("start-up: {} kernel(s) compiled in {total:.0} ms", kernels.len());
-}
-
-impl RenderReport {
-    pub fn summary_line(&self) -> String {
-        format!(
-            "{} | {} | {}x{} | {} spp | depth {} | GPU {:.1} ms | wall {:.1} ms | {:.3} M paths/s | non-finite pixels {}, weights {}",
-            self.device,
-            self.method,
-            self.width,
-            self.height,
-            self.spp,
-            self.max_depth,
-            self.gpu_ms,
-            self.wall_ms,
-            self.paths_per_second * 1e-6,
-            self.nonfinite_pixels,
-            self.nonfinite_weights
-        )
+impl RenderArgs {
+    /// Every flag at its default: what `restir-pt` without a command renders.
+    pub fn parse_defaults() -> Result<Self> {
+        super::parse_args(&[])
     }
-}
 
-/// Refuses an image with non-finite pixels unless --allow-nonfinite: the report (if asked for)
-/// is written first so that the counts are kept, then the error names the frame and the counts.
-/// With --allow-nonfinite it warns and lets the image be written.
-fn guard_nonfinite(args: &RenderArgs, frame: u32, report: &RenderReport) -> Result<()> {
-    if report.nonfinite_pixels == 0 {
-        return Ok(());
+    /// ReSTIR PT's settings, or None for the path tracer.
+    fn restir_settings(&self) -> Option<RestirSettings> {
+        (self.method == MethodArg::Restir).then(|| self.restir.settings())
     }
-    let what = format!(
-        "frame {frame}: {} non-finite pixels ({} non-finite path weights)",
-        report.nonfinite_pixels, report.nonfinite_weights
-    );
-    if args.allow_nonfinite {
-        eprintln!("warning: {what}; writing the image anyway (--allow-nonfinite)");
-        return Ok(());
-    }
-    if let Some(r) = &args.report {
-        std::fs::write(r, serde_json::to_string_pretty(report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
-    }
-    bail!("{what}; no image written (--allow-nonfinite writes it anyway)")
-}
 
-pub(super) fn progress_bar(total: u32) -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})").expect("static template is valid"),
-    );
-    bar
-}
-
-/// Installs a Ctrl-C handler once; later renders share the flag.
-pub(super) fn interrupt_flag() -> Arc<AtomicBool> {
-    static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
-    FLAG.get_or_init(|| {
-        let flag = Arc::new(AtomicBool::new(false));
-        let handler_flag = flag.clone();
-        // Without a handler Ctrl-C still ends the process; only the partial image is lost.
-        if let Err(e) = ctrlc::set_handler(move || handler_flag.store(true, Ordering::Relaxed)) {
-            eprintln!("warning: Ctrl-C will not save a partial image: {e}");
+    /// Refuses flags the method cannot honour and warns about flags it ignores.
+    fn check_method_flags(&self) -> Result<()> {
+        match self.method {
+            MethodArg::Restir => {
+                if self.spp.is_some() {
+                    bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
+                }
+                if self.russian_roulette == Some(Toggle::On) {
+                    eprintln!("warning: --russian-roulette on is ignored by ReSTIR PT, which traces every path to --max-depth (--method pt uses it)");
+                }
+            }
+            MethodArg::Pt => {
+                let ignored = self.restir.changed_flags();
+                if !ignored.is_empty() {
+                    eprintln!("warning: {} set ReSTIR PT and are ignored by --method pt", ignored.join(", "));
+                }
+            }
         }
-        flag
-    })
-    .clone()
+        Ok(())
+    }
+
+    /// The render's settings on `scene`, validated.
+    fn settings(&self, scene: &Scene) -> Result<RenderSettings> {
+        let camera = scene.cameras.get(self.path.camera).unwrap_or(&scene.cameras[0]);
+        let (width, height) = camera.image_size(self.width, self.height);
+        let settings = RenderSettings {
+            width,
+            height,
+            spp: self.spp.unwrap_or(RenderSettings::DEFAULT_SPP),
+            max_depth: self.path.max_depth,
+            seed: self.path.seed,
+            russian_roulette: self.russian_roulette.is_none_or(Toggle::on),
+            camera: self.path.camera,
+        };
+        settings.validate(scene)?;
+        if let Some(restir) = self.restir_settings() {
+            restir.validate(settings.max_depth)?;
+        }
+        Ok(settings)
+    }
+
+    /// The scene camera of frame `frame`: --camera for a static camera, else the scene's camera
+    /// path from --camera (`camera_on_path`).
+    fn frame_camera(&self, frame: u32, cameras: usize) -> usize {
+        if self.static_camera {
+            self.path.camera
+        } else {
+            camera_on_path(self.path.camera, frame, cameras)
+        }
+    }
+
+    /// "frame F | camera C | " for runs of several frames (the camera a frame's reference needs).
+    fn frame_prefix(&self, frame: u32, cameras: usize) -> String {
+        if self.frames > 1 {
+            format!("frame {frame} | camera {} | ", self.frame_camera(frame, cameras))
+        } else {
+            String::new()
+        }
+    }
 }
 
-pub(super) fn create_parent(file: &Path) -> Result<()> {
-    match file.parent().filter(|d| !d.as_os_str().is_empty()) {
-        Some(dir) => std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display())),
-        None => Ok(()),
-    }
+/// Where the images go: --out (default out/<scene>.exr), --png next to it.
+struct OutputPaths {
+    out: PathBuf,
+    png: PathBuf,
 }
 
-/// The scene camera of frame `frame`: --camera for a static camera, else the scene's camera
-/// path from --camera (`camera_on_path`).
-fn frame_camera(args: &RenderArgs, frame: u32, cameras: usize) -> usize {
-    if args.static_camera {
-        args.camera
-    } else {
-        camera_on_path(args.camera, frame, cameras)
-    }
-}
-
-pub fn render(args: RenderArgs) -> Result<()> {
-    let path = scene_path(args.scene.as_deref());
-    if args.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
-    if matches!(args.method, Method::Restir(_)) && args.spp.is_some() {
-        bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
-    }
-    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
-    // accessor counts, before reading vertices or building the BVH.
-    let ctx = open_device(&args.device)?;
-    let load = LoadOptions {
-        max_binding_bytes: Some(ctx.info.max_storage_buffer_range),
-        ..args.load.clone()
-    };
-    let scene = load_with_options(&path, &load)?;
-    if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
-        eprintln!(
-            "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",
-            path.display()
-        );
-    }
-    let camera = scene.cameras.get(args.camera).unwrap_or(&scene.cameras[0]);
-    let (width, height) = camera.image_size(args.width, args.height);
-    let settings = RenderSettings {
-        width,
-        height,
-        spp: args.spp.unwrap_or(64),
-        max_depth: args.max_depth,
-        seed: args.seed,
-        russian_roulette: args.russian_roulette,
-        camera: args.camera,
-    };
-    settings.validate(&scene)?;
-    if let Method::Restir(restir) = &args.method {
-        restir.validate(settings.max_depth)?;
-    }
-    let stem = path
+fn output_paths(args: &RenderArgs, scene_path: &Path) -> Result<OutputPaths> {
+    let stem = scene_path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "render".into());
@@ -218,231 +184,188 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if let Some(dir) = &args.out_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     }
+    Ok(OutputPaths { out, png })
+}
 
-    let outputs = Outputs {
-        out: &out,
-        png: &png,
-        variance: args.variance.as_deref(),
-        out_dir: args.out_dir.as_deref(),
-        exposure: args.exposure,
+/// What both methods' frame loops need.
+struct Job<'a> {
+    ctx: &'a Arc<Context>,
+    scene: &'a Scene,
+    scene_path: &'a Path,
+    args: &'a RenderArgs,
+    settings: &'a RenderSettings,
+    outputs: Outputs<'a>,
+}
+
+impl Job<'_> {
+    /// Prints the frame's line, refuses or warns about non-finite pixels and writes the frame.
+    /// Returns whether the run ends here (the last frame, or Ctrl-C).
+    fn finish_frame(&self, frame: u32, report: &RenderReport, line: &str, image: &crate::render::Image, interrupted: bool) -> Result<bool> {
+        println!("{}{line}", self.args.frame_prefix(frame, self.scene.cameras.len()));
+        guard_nonfinite(self.args.allow_nonfinite, self.args.report.as_deref(), frame, report)?;
+        self.outputs.write_frame(frame, image)?;
+        let last = frame + 1 == self.args.frames || interrupted;
+        if last {
+            self.outputs.write_final(image)?;
+        }
+        Ok(last)
+    }
+
+    fn report(&self, method: String, spp: u32, frame_ms: f64, wall_ms: f64, compile_ms: f64) -> RenderReport {
+        RenderReport {
+            device: self.ctx.info.name.clone(),
+            scene: self.scene_path.display().to_string(),
+            method,
+            width: self.settings.width,
+            height: self.settings.height,
+            spp,
+            max_depth: self.settings.max_depth,
+            gpu_ms: frame_ms,
+            frame_gpu_ms: vec![frame_ms],
+            median_gpu_ms: frame_ms,
+            wall_ms,
+            paths_per_second: 0.0,
+            compile_ms,
+            nonfinite_pixels: 0,
+            nonfinite_weights: 0,
+            restir: None,
+        }
+    }
+}
+
+pub fn render(args: RenderArgs) -> Result<()> {
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    args.check_method_flags()?;
+    let path = args.scene.path();
+    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // accessor counts, before reading vertices or building the BVH.
+    let ctx = open_device(&args.device)?;
+    let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.scene_array_limit())))?;
+    if let Some(line) = scene.surface_summary() {
+        eprintln!("{line}");
+    }
+    if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
+        eprintln!(
+            "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",
+            path.display()
+        );
+    }
+    let settings = args.settings(&scene)?;
+    let paths = output_paths(&args, &path)?;
+    let job = Job {
+        ctx: &ctx,
+        scene: &scene,
+        scene_path: &path,
+        args: &args,
+        settings: &settings,
+        outputs: Outputs {
+            out: &paths.out,
+            png: &paths.png,
+            variance: args.variance.as_deref(),
+            out_dir: args.out_dir.as_deref(),
+            exposure: args.exposure,
+        },
     };
-    let report = match &args.method {
-        Method::PathTracing => render_path_traced(&ctx, &scene, &path, &args, &settings, &outputs)?,
-        Method::Restir(restir) => render_restir(&ctx, &scene, &path, &args, &settings, restir, &outputs)?,
+    let report = match args.restir_settings() {
+        None => render_path_traced(&job)?,
+        Some(restir) => render_restir(&job, &restir)?,
     };
     finish_device(&ctx)?;
-    if let (Some(r), Some(report)) = (&args.report, &report) {
-        std::fs::write(r, serde_json::to_string_pretty(report)?).with_context(|| format!("{}: cannot write the report", r.display()))?;
+    if let Some(r) = &args.report {
+        report.write(r)?;
     }
-    eprintln!("wrote {} and {}", out.display(), png.display());
+    eprintln!("wrote {} and {}", paths.out.display(), paths.png.display());
     Ok(())
 }
 
-struct Outputs<'a> {
-    out: &'a Path,
-    png: &'a Path,
-    variance: Option<&'a Path>,
-    out_dir: Option<&'a Path>,
-    exposure: Exposure,
-}
-
-impl Outputs<'_> {
-    fn write_frame(&self, frame: u32, image: &crate::render::Image) -> Result<()> {
-        if let Some(dir) = self.out_dir {
-            let name = format!("frame_{frame:04}");
-            write_exr(&dir.join(format!("{name}.exr")), image.width, image.height, &image.mean)?;
-            write_png_exposed(&dir.join(format!("{name}.png")), image, exposure_ev(self.exposure, image))?;
-        }
-        Ok(())
-    }
-
-    fn write_final(&self, image: &crate::render::Image) -> Result<()> {
-        write_exr(self.out, image.width, image.height, &image.mean)?;
-        let ev = exposure_ev(self.exposure, image);
-        if self.exposure == Exposure::Auto {
-            eprintln!("PNG preview: exposure {ev:+.2} EV (automatic; --exposure EV sets it)");
-        }
-        write_png_exposed(self.png, image, ev)?;
-        if let Some(v) = self.variance {
-            write_exr(v, image.width, image.height, &image.variance)?;
-        }
-        Ok(())
-    }
-}
-
-/// "frame F | camera C | " for runs of several frames (the camera a frame's reference needs).
-fn frame_prefix(args: &RenderArgs, frame: u32, cameras: usize) -> String {
-    if args.frames > 1 {
-        format!("frame {frame} | camera {} | ", frame_camera(args, frame, cameras))
-    } else {
-        String::new()
-    }
-}
-
-fn render_path_traced(
-    ctx: &Arc<crate::vk::Context>,
-    scene: &Scene,
-    path: &Path,
-    args: &RenderArgs,
-    settings: &RenderSettings,
-    outputs: &Outputs,
-) -> Result<Option<RenderReport>> {
+/// Path-traced frames of --spp each. A moving camera restarts the sums at every frame; a static
+/// one keeps them, so that the image is the average of all frames (one render of F x spp).
+fn render_path_traced(job: &Job) -> Result<RenderReport> {
+    let (args, settings) = (job.args, job.settings);
     let interrupt = interrupt_flag();
     let spinner = compile_progress();
     spinner.set_message("pathtrace.comp");
-    let mut tracer = PathTracer::new(ctx, scene, settings)?;
+    let mut tracer = PathTracer::new(job.ctx, job.scene, settings)?;
     spinner.finish_and_clear();
-    let compile = tracer.compile_report().clone();
-    print_compile_summary(std::slice::from_ref(&compile));
-    for frame in 0..args.frames {
-        if frame > 0 {
-            let camera = frame_camera(args, frame, scene.cameras.len());
+    let compile_ms = tracer.compile_report().total_ms();
+    print_compile_summary(std::slice::from_ref(tracer.compile_report()));
+    let (mut frame_ms, mut frame) = (vec![], 0);
+    loop {
+        if frame > 0 && args.static_camera {
+            tracer.add_samples(settings.spp);
+        } else if frame > 0 {
+            let camera = args.frame_camera(frame, job.scene.cameras.len());
             tracer.restart(
-                scene,
+                job.scene,
                 &RenderSettings {
                     camera,
                     ..settings.clone()
                 },
             )?;
         }
-        let bar = progress_bar(settings.spp);
+        let bar = progress_bar(tracer.target_spp());
         let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
         bar.finish_and_clear();
         let image = tracer.image()?;
-        let frame_report = RenderReport {
-            device: ctx.info.name.clone(),
-            scene: path.display().to_string(),
-            method: "pt".into(),
-            width: settings.width,
-            height: settings.height,
-            spp: stats.spp,
-            max_depth: settings.max_depth,
-            gpu_ms: stats.gpu_ms,
-            wall_ms: stats.wall_ms,
-            paths_per_second: stats.paths_per_second(settings.pixel_count()),
-            compile_ms: compile.total_ms(),
-            nonfinite_pixels: image.non_finite_count(),
-            nonfinite_weights: stats.nonfinite_paths,
-            restir: None,
-        };
-        println!("{}{}", frame_prefix(args, frame, scene.cameras.len()), frame_report.summary_line());
-        guard_nonfinite(args, frame, &frame_report)?;
-        outputs.write_frame(frame, &image)?;
+        frame_ms.push(stats.gpu_ms);
+        let mut report = job.report("pt".into(), stats.spp, stats.gpu_ms, stats.wall_ms, compile_ms);
+        report.set_frame_times(&frame_ms);
+        // A static camera's stats count every frame's samples; the throughput is this frame's.
+        let frame_spp = stats.spp.saturating_sub(if args.static_camera { frame * settings.spp } else { 0 });
+        report.paths_per_second = stats.paths_per_second(settings.pixel_count()) * frame_spp as f64 / stats.spp.max(1) as f64;
+        report.nonfinite_pixels = image.non_finite_count();
+        report.nonfinite_weights = stats.nonfinite_paths;
         if stats.interrupted {
             eprintln!("interrupted: writing the {} spp of frame {frame} accumulated so far", stats.spp);
         }
-        if frame + 1 == args.frames || stats.interrupted {
-            outputs.write_final(&image)?;
-            return Ok(Some(frame_report));
+        if job.finish_frame(frame, &report, &report.summary_line(), &image, stats.interrupted)? {
+            return Ok(report);
         }
-    }
-    Ok(None)
-}
-
-/// What a ReSTIR PT frame reports beyond the common summary.
-#[derive(Serialize, Clone)]
-pub struct RestirFrameReport {
-    pub frames: u32,
-    pub pass_ms: Vec<(String, f64)>,
-    pub shifts_attempted: u32,
-    pub shifts_failed: u32,
-    pub failed_shift_rate: f64,
-    pub nonfinite_weights: u32,
-    pub nonfinite_pixels: u32,
-    pub candidates_dropped: u32,
-}
-
-impl RestirFrameReport {
-    fn from_stats(frames: u32, stats: &FrameStats) -> Self {
-        let c = &stats.counters;
-        RestirFrameReport {
-            frames,
-            pass_ms: match stats.pass_ms {
-                Some(ms) => PASS_NAMES.iter().zip(ms).map(|(n, t)| (n.to_string(), t)).collect(),
-                None => vec![],
-            },
-            shifts_attempted: c.shifts_attempted,
-            shifts_failed: c.shifts_failed,
-            failed_shift_rate: stats.failed_shift_rate(),
-            nonfinite_weights: c.nonfinite_weights,
-            nonfinite_pixels: c.nonfinite_pixels,
-            candidates_dropped: c.candidates_dropped,
-        }
-    }
-
-    fn summary(&self) -> String {
-        let passes: Vec<String> = self.pass_ms.iter().map(|(n, t)| format!("{n} {t:.1}")).collect();
-        format!(
-            "passes ms: {} | failed shifts {}/{} ({:.1}%) | non-finite weights {} | non-finite pixels {}",
-            if passes.is_empty() { "n/a".to_string() } else { passes.join(", ") },
-            self.shifts_failed,
-            self.shifts_attempted,
-            100.0 * self.failed_shift_rate,
-            self.nonfinite_weights,
-            self.nonfinite_pixels
-        )
+        frame += 1;
     }
 }
 
-fn render_restir(
-    ctx: &Arc<crate::vk::Context>,
-    scene: &Scene,
-    path: &Path,
-    args: &RenderArgs,
-    settings: &RenderSettings,
-    restir: &RestirSettings,
-    outputs: &Outputs,
-) -> Result<Option<RenderReport>> {
+/// ReSTIR PT frames; a static camera averages them (`Restir::frame`'s accumulate).
+fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
+    let (args, settings) = (job.args, job.settings);
     let interrupt = interrupt_flag();
     let spinner = compile_progress();
-    let mut renderer = Restir::with_progress(ctx, scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
+    let mut renderer = Restir::with_progress(job.ctx, job.scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
     spinner.finish_and_clear();
     let compile_reports = renderer.compile_reports();
     print_compile_summary(&compile_reports);
-    let mut gpu_ms = 0.0;
-    let mut report = None;
-    for frame in 0..args.frames {
-        let stats = renderer.frame(scene, frame_camera(args, frame, scene.cameras.len()), args.static_camera)?;
+    let compile_ms = compile_reports.iter().map(|k| k.total_ms()).sum();
+    let spp = restir.candidates * restir.reservoirs;
+    let (mut frame_ms, mut frame) = (vec![], 0);
+    loop {
+        let stats = renderer.frame(job.scene, args.frame_camera(frame, job.scene.cameras.len()), args.static_camera)?;
         let image = renderer.image()?;
-        let frame_ms = stats.gpu_ms().unwrap_or(stats.wall_ms);
-        gpu_ms += frame_ms;
+        frame_ms.push(stats.gpu_ms().unwrap_or(stats.wall_ms));
         let detail = RestirFrameReport::from_stats(frame + 1, &stats);
-        let frame_report = RenderReport {
-            device: ctx.info.name.clone(),
-            scene: path.display().to_string(),
-            method: restir.label(),
-            width: settings.width,
-            height: settings.height,
-            spp: restir.candidates * restir.reservoirs,
-            max_depth: settings.max_depth,
-            gpu_ms: frame_ms,
-            wall_ms: stats.wall_ms,
-            paths_per_second: settings.pixel_count() as f64 * (restir.candidates * restir.reservoirs) as f64 / (frame_ms * 1e-3),
-            compile_ms: compile_reports.iter().map(|k| k.total_ms()).sum(),
-            nonfinite_pixels: image.non_finite_count(),
-            nonfinite_weights: detail.nonfinite_weights as u64,
-            restir: Some(detail.clone()),
-        };
-        println!(
-            "{}{} | {}",
-            frame_prefix(args, frame, scene.cameras.len()),
-            frame_report.summary_line(),
-            detail.summary()
-        );
-        guard_nonfinite(args, frame, &frame_report)?;
-        outputs.write_frame(frame, &image)?;
+        let mut report = job.report(restir.label(), spp, frame_ms[frame as usize], stats.wall_ms, compile_ms);
+        report.set_frame_times(&frame_ms);
+        report.paths_per_second = settings.pixel_count() as f64 * spp as f64 / (report.gpu_ms * 1e-3);
+        report.nonfinite_pixels = image.non_finite_count();
+        report.nonfinite_weights = detail.nonfinite_weights as u64;
+        let line = format!("{} | {}", report.summary_line(), detail.summary());
+        report.restir = Some(detail);
         let interrupted = interrupt.load(Ordering::Relaxed);
         if interrupted {
             eprintln!("interrupted: writing frame {frame}");
         }
-        if frame + 1 == args.frames || interrupted {
-            outputs.write_final(&image)?;
-            report = Some(frame_report);
-            break;
+        if job.finish_frame(frame, &report, &line, &image, interrupted)? {
+            if frame > 0 {
+                let total: f64 = frame_ms.iter().sum();
+                eprintln!(
+                    "{} frames, {total:.1} ms of GPU time in all (median {:.1} ms per frame)",
+                    frame + 1,
+                    report.median_gpu_ms
+                );
+            }
+            return Ok(report);
         }
+        frame += 1;
     }
-    if args.frames > 1 {
-        eprintln!("{} frames, {gpu_ms:.1} ms of GPU time in all", args.frames);
-    }
-    Ok(report)
 }

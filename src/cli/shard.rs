@@ -238,8 +238,23 @@ pub fn merge_shards(paths: &[PathBuf]) -> Result<(ShardSums, Vec<u32>)> {
 }
 
 /// `restir-pt merge`: shards to the mean EXR at `out` and the variance EXR next to it.
-pub fn merge(shards: &[PathBuf], out: &Path, allow_nonfinite: bool) -> Result<()> {
-    let (merged, missing) = merge_shards(shards)?;
+/// `restir-pt merge`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// Shard EXRs written by `reference --shard I/N`.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
+    #[arg(long)]
+    pub allow_nonfinite: bool,
+}
+
+pub fn merge(args: MergeArgs) -> Result<()> {
+    let (out, allow_nonfinite) = (args.out.as_path(), args.allow_nonfinite);
+    let (merged, missing) = merge_shards(&args.shards)?;
     let meta = &merged.meta;
     if !missing.is_empty() {
         eprintln!(
@@ -263,7 +278,7 @@ pub fn merge(shards: &[PathBuf], out: &Path, allow_nonfinite: bool) -> Result<()
         }
         eprintln!("warning: {nonfinite} non-finite pixels; writing the reference anyway (--allow-nonfinite)");
     }
-    super::render::create_parent(out)?;
+    super::render_output::create_parent(out)?;
     let variance = variance_path(out);
     write_exr(out, image.width, image.height, &image.mean)?;
     write_exr(&variance, image.width, image.height, &image.variance)?;
@@ -277,7 +292,7 @@ pub fn merge(shards: &[PathBuf], out: &Path, allow_nonfinite: bool) -> Result<()
     super::reference_record::write_record(out, &record)?;
     println!(
         "merged {} shards of {} | {}x{} | {} spp",
-        shards.len(),
+        args.shards.len(),
         meta.scene,
         meta.width,
         meta.height,

@@ -13,38 +13,59 @@ use std::time::Instant;
 use anyhow::{bail, Context as _, Result};
 use glam::Vec3;
 
-use super::method_spec::{parse_methods, MethodRenderer, MethodSpec};
+use clap::Args;
+
+use super::args::{argv, DeviceArgs, RestirArgs, SweepArgs};
+use super::method_spec::{parse_methods, MethodRenderer, MethodSpec, DEFAULT_METHODS};
 use super::sweep::{
     job_file, parse_optional, read_job_reports, read_job_rows, start_job, write_accounting, write_job_report, write_plan, JobReport,
     SweepMode, COMMIT,
 };
-use super::{bundled_file, finish_device, load_with_warnings, open_device, DeviceArgs};
-use crate::charts::{write_line_chart, LineChart, Series};
+use super::{bundled_file, finish_device, load_with_warnings, open_device};
+use crate::cli::charts::{write_line_chart, LineChart, Series};
 use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
-use crate::render::{PathTracer, RenderSettings, RestirSettings};
+use crate::render::{PathTracer, RenderSettings};
 use crate::scene::{camera_on_path, Scene};
 use crate::vk::Context;
 
+/// `restir-pt stability`.
+#[derive(Args, Debug, Clone)]
 pub struct StabilityArgs {
+    /// Scenes to run (default: every bundled scene).
+    #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<PathBuf>,
+    /// Methods, as in `compare`.
+    #[arg(long, value_delimiter = ',', default_value = DEFAULT_METHODS)]
     pub methods: Vec<String>,
+    /// Frames per run (at least 2: flicker compares consecutive frames).
+    #[arg(long, default_value_t = 16)]
     pub frames: u32,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 64)]
     pub width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 64)]
     pub height: u32,
+    /// Maximum number of path segments, as in `render`.
+    #[arg(long, default_value_t = RenderSettings::DEFAULT_MAX_DEPTH)]
     pub max_depth: u32,
-    /// Paths per pixel of each camera pose's reference.
+    /// Paths per pixel of each camera pose's path-traced reference.
+    #[arg(long, default_value_t = 512)]
     pub reference_spp: u32,
-    /// Paths per pixel of a path-traced frame.
+    /// Paths per pixel of one path-traced frame.
+    #[arg(long, default_value_t = 4)]
     pub pt_spp: u32,
+    /// Seed of the random numbers, as in `render`.
+    #[arg(long, default_value_t = 0)]
     pub seed: u32,
-    pub restir: RestirSettings,
-    /// Folder for stability.csv and the charts; None writes nothing.
-    pub out_dir: Option<PathBuf>,
-    /// One process for everything, or a job list (one job per scene and method), one job of
-    /// it, or the merge of its jobs; all but the first need `out_dir`.
-    pub sweep: SweepMode,
-    /// The command line after `restir-pt` (for the job list's commands).
-    pub argv: Vec<String>,
+    #[command(flatten)]
+    pub restir: RestirArgs,
+    /// Folder for stability.csv and <scene>_rel_mse.svg/png.
+    #[arg(long, default_value = "out/stability")]
+    pub out_dir: PathBuf,
+    #[command(flatten)]
+    pub sweep: SweepArgs,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -120,7 +141,7 @@ fn scene_name(path: &Path) -> String {
 
 /// The bundled scenes, in their documented order.
 pub fn bundled_scene_paths() -> Vec<PathBuf> {
-    crate::bundled_scenes::BUNDLED_SCENES
+    crate::scene::bundled_scenes::BUNDLED_SCENES
         .iter()
         .map(|s| bundled_file(&Path::new("scenes").join(s.file_name)))
         .collect()
@@ -166,7 +187,7 @@ fn setup(args: &StabilityArgs) -> Result<Setup> {
     if args.reference_spp == 0 || args.pt_spp == 0 {
         bail!("--reference-spp and --pt-spp must be at least 1");
     }
-    let methods = parse_methods(&args.methods, &args.restir)?;
+    let methods = parse_methods(&args.methods, &args.restir.settings())?;
     let paths = if args.scenes.is_empty() {
         bundled_scene_paths()
     } else {
@@ -190,40 +211,39 @@ fn setup(args: &StabilityArgs) -> Result<Setup> {
             r.validate(args.max_depth)?;
         }
     }
-    if let Some(dir) = &args.out_dir {
-        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
-    }
+    let dir = &args.out_dir;
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     Ok(Setup { methods, scenes, base })
 }
 
 pub fn stability(args: StabilityArgs) -> Result<Vec<StabilityRow>> {
+    let mode = args.sweep.mode()?;
     let setup = setup(&args)?;
-    let out_dir = match (&args.sweep, &args.out_dir) {
-        (SweepMode::All, _) => None,
-        (_, Some(dir)) => Some(dir),
-        (_, None) => bail!("--plan, --job and --merge need an output folder"),
-    };
-    let rows = match (&args.sweep, out_dir) {
-        (SweepMode::Plan(plan), Some(dir)) => {
-            write_plan(plan, &args.argv, &setup.labels(), dir)?;
+    let dir = &args.out_dir;
+    let rows = match &mode {
+        SweepMode::Plan(plan) => {
+            write_plan(plan, &argv(), &setup.labels(), dir)?;
             return Ok(vec![]);
         }
-        (SweepMode::Job(k), Some(dir)) => return run_job(&args, &setup, *k, dir),
-        (SweepMode::Merge(jobs), Some(dir)) => merge(&setup, jobs, dir)?,
-        _ => {
-            let ctx = open_device(&args.device)?;
-            let mut rows = vec![];
-            for (name, scene) in &setup.scenes {
-                let mut references = setup.references(&ctx, &args, scene)?;
-                for method in &setup.methods {
-                    rows.extend(run_method(&ctx, &args, &setup, name, scene, method, &mut references)?.0);
-                }
-            }
-            finish_device(&ctx)?;
-            rows
-        }
+        SweepMode::Job(k) => return run_job(&args, &setup, *k, dir),
+        SweepMode::Merge(jobs) => merge(&setup, jobs, dir)?,
+        SweepMode::All => run_all(&args, &setup)?,
     };
     write_results(&args, &setup, &rows)?;
+    Ok(rows)
+}
+
+/// Every method on every scene in this process.
+fn run_all(args: &StabilityArgs, setup: &Setup) -> Result<Vec<StabilityRow>> {
+    let ctx = open_device(&args.device)?;
+    let mut rows = vec![];
+    for (name, scene) in &setup.scenes {
+        let mut references = setup.references(&ctx, args, scene)?;
+        for method in &setup.methods {
+            rows.extend(run_method(&ctx, args, setup, name, scene, method, &mut references)?.0);
+        }
+    }
+    finish_device(&ctx)?;
     Ok(rows)
 }
 
@@ -321,14 +341,11 @@ fn write_results(args: &StabilityArgs, setup: &Setup, rows: &[StabilityRow]) -> 
     for (name, _) in &setup.scenes {
         let scene_rows: Vec<StabilityRow> = rows.iter().filter(|r| r.scene == *name).cloned().collect();
         print_summary(&scene_rows, &setup.methods);
-        if let Some(dir) = &args.out_dir {
-            write_chart(dir, name, &scene_rows, &setup.methods)?;
-        }
+        write_chart(&args.out_dir, name, &scene_rows, &setup.methods)?;
     }
-    if let Some(dir) = &args.out_dir {
-        write_csv(&dir.join("stability.csv"), rows)?;
-        eprintln!("wrote stability.csv and <scene>_rel_mse.svg/png in {}", dir.display());
-    }
+    let dir = &args.out_dir;
+    write_csv(&dir.join("stability.csv"), rows)?;
+    eprintln!("wrote stability.csv and <scene>_rel_mse.svg/png in {}", dir.display());
     let nonfinite: usize = rows.iter().map(|r| r.nonfinite_pixels).sum();
     if nonfinite > 0 {
         bail!("{nonfinite} non-finite pixels over all frames (see the summary above)");

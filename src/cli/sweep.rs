@@ -119,7 +119,7 @@ pub fn write_plan(plan: &Path, argv: &[String], labels: &[String], out_dir: &Pat
         text.push_str(&serde_json::to_string(&line)?);
         text.push('\n');
     }
-    super::render::create_parent(plan)?;
+    super::render_output::create_parent(plan)?;
     std::fs::write(plan, text).with_context(|| format!("{}: cannot write the plan", plan.display()))?;
     println!("wrote {} jobs to {}", labels.len(), plan.display());
     println!("run one: restir-pt {} --job K", base.join(" "));

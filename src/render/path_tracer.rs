@@ -8,8 +8,8 @@ use anyhow::{Context as _, Result};
 
 use super::counters::{TraversalCounters, COUNTER_COUNT};
 use super::{Image, RenderSettings, SceneGpu};
-use crate::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::error::GpuError;
+use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::scene::Scene;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
@@ -159,6 +159,18 @@ impl PathTracer {
     /// one render; `restart` goes back to 0. Call before the first dispatch.
     pub fn start_at_sample(&mut self, first: u32) {
         self.first_sample = first;
+    }
+
+    /// Raises the render's target by `spp` paths per pixel and keeps the sums: the next `render`
+    /// continues the same sample sequence, so that its image averages all samples so far (the
+    /// image of one render of the total spp, up to float rounding of the sums).
+    pub fn add_samples(&mut self, spp: u32) {
+        self.settings.spp = self.settings.spp.saturating_add(spp);
+    }
+
+    /// The paths per pixel `render` runs up to.
+    pub fn target_spp(&self) -> u32 {
+        self.settings.spp
     }
 
     /// Adds `samples` paths per pixel in one submission. Returns its GPU time in ms (None if the

@@ -13,7 +13,7 @@ use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
 use crate::scene::Scene;
-use crate::shift::ShiftParams;
+use crate::shading::shift::ShiftParams;
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
 const LOCAL_SIZE: u32 = 8;
@@ -21,7 +21,7 @@ const LOCAL_SIZE: u32 = 8;
 /// Shared memory of one workgroup of the ReSTIR kernels: the path being built by each of its
 /// LOCAL_SIZE² invocations (glsl/shift.glsl, `path_vertices`, `path_lobes`, `path_weights`),
 /// per vertex a 32-byte vertex, a lobe and a 16-byte weight row.
-const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
+const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
 
 /// GPU milliseconds per pass of one frame (indexed like PASS_NAMES); None without timestamps.
 #[derive(Debug, Clone)]

@@ -2,22 +2,23 @@
 
 use anyhow::{bail, Result};
 
-use crate::path_record::MAX_PATH_LENGTH;
+use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// The shift mapping used for reuse (and, inverted, for its MIS weights).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ShiftKind {
     Reconnection,
     Replay,
     Hybrid,
 }
 
-/// The resampling MIS weights of reuse.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The resampling MIS weights of reuse (`--mis gbh|pairwise`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ReuseMis {
-    /// Generalized balance heuristic with confidence weights, O(M^2) inverse shifts.
+    /// Generalized balance heuristic with confidence weights (O(M^2) shifts).
+    #[value(name = "gbh")]
     GeneralizedBalance,
-    /// Defensive pairwise MIS, O(M).
+    /// Defensive pairwise MIS (O(M) shifts).
     Pairwise,
 }
 

@@ -1,17 +1,22 @@
 //! The scene's buffers (bindings 1-4 of glsl/scene_bindings.glsl) and the `#define`s that
 //! specialise scene kernels to what the scene contains.
+//!
+//! Three layouts, chosen by size: uniform buffers (CPU devices, small scenes), storage buffers,
+//! and, when the triangles, BVH nodes or emitters exceed one binding's range
+//! (`DeviceInfo::scene_binding_limit`), those three arrays in buffers reached by device address,
+//! with bindings 1, 2 and 4 holding each one's address and length (`SCENE_ADDRESSED`).
 
 use std::sync::Arc;
 
 use anyhow::{Context as _, Result};
 use ash::vk::PhysicalDeviceType;
 
-use crate::bsdf::lobe_weights;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
-use crate::texture::NO_TEXTURE;
-use crate::vk::{Binding, Buffer, Context, Kernel};
+use crate::shading::bsdf::lobe_weights;
+use crate::shading::texture::NO_TEXTURE;
+use crate::vk::{Binding, Buffer, BufferUsage, Context, Kernel};
 
 use super::surface_gpu::SurfaceGpu;
 
@@ -22,9 +27,22 @@ pub struct SceneGpu {
     pub emitters: Buffer,
     /// Scene arrays are bound as uniform buffers (CPU devices, small scenes), else storage buffers.
     pub uniform: bool,
+    /// With the addressed layout: the records bound in place of the triangles, nodes and
+    /// emitters (address, then length; see `address_record`).
+    addresses: Option<[Buffer; 3]>,
     /// Surface attributes and textures (descriptor set 1), if the scene has any.
     pub surface: Option<SurfaceGpu>,
     defines: Vec<(&'static str, String)>,
+}
+
+/// The 16 bytes of a binding that points at an addressed array: its device address (a
+/// GL_EXT_buffer_reference, 8 bytes at offset 0 under std430) and its element count.
+fn address_record(ctx: &Arc<Context>, name: &str, array: &Buffer, length: usize) -> Result<Buffer, GpuError> {
+    let address = array.device_address();
+    let record = [address as u32, (address >> 32) as u32, length as u32, 0];
+    let buffer = Buffer::new(ctx, name, std::mem::size_of_val(&record) as u64, BufferUsage::Params)?;
+    buffer.write(&record)?;
+    Ok(buffer)
 }
 
 impl SceneGpu {
@@ -45,27 +63,46 @@ impl SceneGpu {
             std::mem::size_of_val(scene.materials.as_slice()),
             std::mem::size_of_val(emitter_rows.as_slice()),
         ];
+        // Materials stay bound: a binding holds millions of them.
+        let [tri_bytes, node_bytes, _, emitter_bytes] = arrays;
+        let addressed = ctx.info.buffer_device_address
+            && [tri_bytes, node_bytes, emitter_bytes]
+                .iter()
+                .any(|&bytes| bytes as u64 > ctx.info.scene_binding_limit);
         // Divergent uniform-buffer indexing serialises on GPUs; on llvmpipe it beats storage loads.
-        let uniform = ctx.info.device_type == PhysicalDeviceType::CPU
+        let uniform = !addressed
+            && ctx.info.device_type == PhysicalDeviceType::CPU
             && arrays.iter().all(|&bytes| bytes as u64 <= ctx.info.max_uniform_buffer_range);
+        let big = if addressed { BufferUsage::Addressed } else { BufferUsage::Storage };
         let placeholder = [Triangle::default()];
         let no_material = [Material::default()];
+        // Vulkan has no empty buffers; a scene of points and lines alone has no triangles,
+        // and its BVH's one empty leaf never reads this placeholder.
+        let triangles = if scene.triangles.is_empty() {
+            &placeholder[..]
+        } else {
+            &scene.triangles
+        };
+        let triangles = upload("triangles", Buffer::with_data(ctx, "triangles", triangles, big))?;
+        let nodes = upload("BVH nodes", Buffer::with_data(ctx, "BVH nodes", &scene.nodes, big))?;
+        let emitters = upload("emitters", Buffer::with_data(ctx, "emitters", &emitter_rows, big))?;
+        let addresses = if addressed {
+            let record = |name: &str, array: &Buffer, length: usize| upload(name, address_record(ctx, name, array, length));
+            Some([
+                record("triangle addresses", &triangles, scene.triangles.len())?,
+                record("BVH node addresses", &nodes, scene.nodes.len())?,
+                record("emitter addresses", &emitters, emitter_rows.len())?,
+            ])
+        } else {
+            None
+        };
+        let mut defines = scene_defines(scene, uniform);
+        if addressed {
+            defines.push(("SCENE_ADDRESSED", "1".to_string()));
+        }
         Ok(Self {
-            // Vulkan has no empty buffers; a scene of points and lines alone has no triangles,
-            // and its BVH's one empty leaf never reads this placeholder.
-            triangles: upload(
-                "triangles",
-                Buffer::from_slice(
-                    ctx,
-                    "triangles",
-                    if scene.triangles.is_empty() {
-                        &placeholder
-                    } else {
-                        &scene.triangles
-                    },
-                ),
-            )?,
-            nodes: upload("BVH nodes", Buffer::from_slice(ctx, "BVH nodes", &scene.nodes))?,
+            triangles,
+            nodes,
             materials: upload(
                 "materials",
                 Buffer::from_slice(
@@ -78,16 +115,25 @@ impl SceneGpu {
                     },
                 ),
             )?,
-            emitters: upload("emitters", Buffer::from_slice(ctx, "emitters", &emitter_rows))?,
+            emitters,
             uniform,
+            addresses,
             surface: SurfaceGpu::upload(ctx, scene)?,
-            defines: scene_defines(scene, uniform),
+            defines,
         })
+    }
+
+    /// Whether the triangles, nodes and emitters are reached by device address.
+    pub fn addressed(&self) -> bool {
+        self.addresses.is_some()
     }
 
     /// The buffers for bindings 0-4, the frame parameters first.
     pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<&'a Buffer> {
-        vec![params, &self.triangles, &self.nodes, &self.materials, &self.emitters]
+        match &self.addresses {
+            Some([triangles, nodes, emitters]) => vec![params, triangles, nodes, &self.materials, emitters],
+            None => vec![params, &self.triangles, &self.nodes, &self.materials, &self.emitters],
+        }
     }
 
     /// The descriptor kinds of bindings 0-4.

@@ -4,6 +4,7 @@ use anyhow::{bail, Result};
 
 use crate::gpu_types::{FrameParams, FLAG_RUSSIAN_ROULETTE};
 use crate::scene::Scene;
+use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// Sides beyond this are refused: per-pixel indices stay far inside u32, and 8x8 workgroups
 /// stay within 8192 per axis, below the 65535 every Vulkan device supports.
@@ -24,10 +25,10 @@ pub struct RenderSettings {
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
-            width: 256,
-            height: 256,
-            spp: 64,
-            max_depth: 8,
+            width: Self::DEFAULT_WIDTH,
+            height: Self::DEFAULT_HEIGHT,
+            spp: Self::DEFAULT_SPP,
+            max_depth: Self::DEFAULT_MAX_DEPTH,
             seed: 0,
             russian_roulette: true,
             camera: 0,
@@ -36,6 +37,14 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    pub const DEFAULT_WIDTH: u32 = 256;
+    pub const DEFAULT_HEIGHT: u32 = 256;
+    /// Paths per pixel of a path-traced image.
+    pub const DEFAULT_SPP: u32 = 64;
+    /// Path segments: the most ReSTIR PT's path records hold, so that one default serves both
+    /// methods.
+    pub const DEFAULT_MAX_DEPTH: u32 = MAX_PATH_LENGTH as u32;
+
     pub fn validate(&self, scene: &Scene) -> Result<()> {
         let (w, h) = (self.width, self.height);
         if w == 0 || h == 0 {

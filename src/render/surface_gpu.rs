@@ -27,7 +27,21 @@ impl SurfaceGpu {
         let source = scene.source.display();
         let mut buffers = vec![Buffer::from_slice(ctx, "surface attributes", &scene.surfaces)
             .with_context(|| format!("{source}: uploading the surface attributes"))?];
+        let attribute_bytes = std::mem::size_of_val(scene.surfaces.as_slice()) as u64;
+        if attribute_bytes > ctx.info.scene_binding_limit {
+            anyhow::bail!(
+                "{source}: the vertex attributes take {attribute_bytes} bytes, more than one binding holds on this device ({})",
+                ctx.info.scene_binding_limit
+            );
+        }
         let t = &scene.textures;
+        let texel_bytes = std::mem::size_of_val(t.texels.as_slice()) as u64;
+        if texel_bytes > ctx.info.scene_binding_limit {
+            anyhow::bail!(
+                "{source}: the textures take {texel_bytes} bytes, more than one binding holds on this device ({}); textures are not split across bindings",
+                ctx.info.scene_binding_limit
+            );
+        }
         if !t.is_empty() {
             // Vulkan has no empty buffers: a scene whose only non-opaque material has no texture.
             let headers = if t.headers.is_empty() {

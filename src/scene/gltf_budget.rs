@@ -7,6 +7,16 @@ use anyhow::{bail, Result};
 use super::gltf_loader::{problem, Loader, MAX_NODE_DEPTH, MAX_NODE_INSTANCES};
 use crate::gpu_types::Triangle;
 
+/// The most bytes the device lets one scene array (the triangles, the largest) take, and the
+/// limit's Vulkan name for messages: maxStorageBufferRange when arrays are bound,
+/// maxMemoryAllocationSize when they are reached by device address
+/// (`crate::vk::Context::scene_array_limit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArrayLimit {
+    pub bytes: u64,
+    pub name: &'static str,
+}
+
 /// Triangles a primitive of `mode` draws from `count` vertices or indices (before degenerate
 /// ones are dropped); points and lines draw none.
 fn triangles_of(mode: gltf::mesh::Mode, count: usize) -> usize {
@@ -58,17 +68,18 @@ impl Loader<'_> {
         total
     }
 
-    /// Fails if the estimated triangles would not fit one storage-buffer binding of
-    /// `limit_bytes` (the device's maxStorageBufferRange).
-    pub(super) fn check_binding_budget(&self, scene: &gltf::Scene, limit_bytes: u64) -> Result<()> {
+    /// Fails if the estimated triangles would not fit one array of `limit`.
+    pub(super) fn check_array_budget(&self, scene: &gltf::Scene, limit: ArrayLimit) -> Result<()> {
         let estimate = self.estimate_triangles(scene);
         let bytes = estimate as u64 * std::mem::size_of::<Triangle>() as u64;
-        if bytes > limit_bytes {
+        if bytes > limit.bytes {
             bail!(problem(
                 self.path,
                 format!(
-                    "about {estimate} triangles need {bytes} bytes in one storage buffer, more than the device allows per binding ({limit_bytes} bytes, maxStorageBufferRange; at most {} triangles)",
-                    limit_bytes / std::mem::size_of::<Triangle>() as u64
+                    "about {estimate} triangles need {bytes} bytes in one buffer, more than the device allows ({} bytes, {}; at most {} triangles)",
+                    limit.bytes,
+                    limit.name,
+                    limit.bytes / std::mem::size_of::<Triangle>() as u64
                 )
             ));
         }

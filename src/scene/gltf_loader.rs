@@ -7,12 +7,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use glam::{DMat4, DVec3, Vec3};
 
+pub use super::gltf_budget::ArrayLimit;
 use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
-use crate::environment::EnvironmentMap;
 use crate::gpu_types::{Material, Triangle};
-use crate::surface::TriangleSurface;
-use crate::texture::SceneTextures;
+use crate::scene::environment::EnvironmentMap;
+use crate::shading::surface::TriangleSurface;
+use crate::shading::texture::SceneTextures;
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
 pub(super) const MAX_NODE_DEPTH: usize = 256;
@@ -81,9 +82,9 @@ pub struct LoadOptions {
     pub environment: Option<Vec3>,
     /// An equirectangular environment map (.exr or .hdr) that replaces the file's environment.
     pub environment_map: Option<PathBuf>,
-    /// The device's per-binding limit (bytes): a file whose accessor counts promise more
-    /// triangles than one binding holds fails before its vertices are read.
-    pub max_binding_bytes: Option<u64>,
+    /// The most bytes the device lets one scene array take: a file whose accessor counts
+    /// promise more triangles than that fails before its vertices are read.
+    pub array_limit: Option<ArrayLimit>,
 }
 
 /// Loads a glTF or GLB file. Errors are one line naming the file and the problem; warnings are
@@ -238,8 +239,8 @@ impl<'a> Loader<'a> {
                 .or_else(|| doc.scenes().next())
                 .ok_or_else(|| problem(self.path, "the file has no scene"))?,
         };
-        if let Some(limit) = options.max_binding_bytes {
-            self.check_binding_budget(&scene, limit)?;
+        if let Some(limit) = options.array_limit {
+            self.check_array_budget(&scene, limit)?;
         }
         self.walk_nodes(&scene)?;
         // --env replaces the file's environment; the scene's extras come before the root's.
@@ -249,7 +250,8 @@ impl<'a> Loader<'a> {
         };
         let map = options.environment_map.as_deref().map(EnvironmentMap::load).transpose()?;
         let sources = std::mem::take(&mut self.material_sources);
-        let textures = self.load_textures(&sources, options.max_binding_bytes.unwrap_or(u64::MAX).min(u32::MAX as u64))?;
+        // Texel offsets are 32-bit; the device's binding limit is checked at upload.
+        let textures = self.load_textures(&sources, 4 * u32::MAX as u64)?;
         self.finish(environment, map, textures)
     }
 

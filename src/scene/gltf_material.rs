@@ -125,7 +125,7 @@ impl Loader<'_> {
             ("emissiveStrength", strength.is_finite() && strength >= 0.0),
             ("transmissionFactor", (0.0..=1.0).contains(&transmission)),
             // Within rounding below 1 is index-matched (docs/materials.md), not an error.
-            ("ior", ior.is_finite() && (ior >= 1.0 || crate::bsdf::index_matched(ior))),
+            ("ior", ior.is_finite() && (ior >= 1.0 || crate::shading::bsdf::index_matched(ior))),
         ];
         if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
             bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));

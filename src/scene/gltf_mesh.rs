@@ -9,7 +9,7 @@ use glam::{DMat4, DQuat, DVec3, Vec3};
 use super::gltf_json::Instancing;
 use super::gltf_loader::{problem, Loader, MAX_TRIANGLES};
 use crate::gpu_types::{Triangle, NO_EMITTER};
-use crate::surface::TriangleSurface;
+use crate::shading::surface::TriangleSurface;
 
 /// Vertex colours are rounded to this step before materials are shared between triangles.
 const COLOUR_STEP: f32 = 1.0 / 4096.0;

@@ -5,7 +5,7 @@
 use glam::{DMat3, DMat4, Vec2, Vec3, Vec4};
 
 use super::gltf_loader::Loader;
-use crate::surface::TriangleSurface;
+use crate::shading::surface::TriangleSurface;
 
 /// A primitive's vertex attributes in scene space (`None`: the file has none, or unusable ones).
 pub(super) struct PrimitiveSurface {

@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use anyhow::{bail, Result};
 
 use super::gltf_loader::{problem, Loader};
-use crate::texture::{
+use crate::shading::texture::{
     texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE,
     TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
 };

@@ -6,8 +6,8 @@ use glam::{Vec2, Vec3};
 
 use super::Scene;
 use crate::gpu_types::Material;
-use crate::surface::{surface_at, SurfaceHit, TriangleSurface};
-use crate::texture::{normal_mapped, textured_material};
+use crate::shading::surface::{surface_at, SurfaceHit, TriangleSurface};
+use crate::shading::texture::{normal_mapped, textured_material};
 
 impl Scene {
     /// The surface of triangle `triangle` at barycentrics `bary` (flat where the scene has no
@@ -37,5 +37,23 @@ impl Scene {
         }
         let index = self.triangles[triangle as usize].material as usize;
         normal_mapped(&self.textures.materials[index], &self.textures, &s)
+    }
+
+    /// One line on the vertex attributes and textures and the device memory they take, or
+    /// `None` for a scene without them.
+    pub fn surface_summary(&self) -> Option<String> {
+        if self.surfaces.is_empty() {
+            return None;
+        }
+        let mib = |bytes: usize| bytes as f64 / (1024.0 * 1024.0);
+        let attributes = mib(std::mem::size_of_val(self.surfaces.as_slice()));
+        let t = &self.textures;
+        let sizes: Vec<String> = t.headers.iter().map(|h| format!("{}x{}", h.width, h.height)).collect();
+        Some(format!(
+            "surface: vertex attributes {attributes:.2} MiB; {} texture(s) [{}] {:.2} MiB (RGBA8 texels in a storage buffer, no mipmaps)",
+            t.headers.len(),
+            sizes.join(", "),
+            mib(t.gpu_bytes())
+        ))
     }
 }

@@ -1,6 +1,9 @@
 //! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
 
+pub mod bundled_scenes;
+pub mod bvh;
 mod camera;
+pub mod environment;
 mod gltf_budget;
 mod gltf_json;
 mod gltf_loader;
@@ -8,11 +11,12 @@ mod gltf_material;
 mod gltf_mesh;
 mod gltf_surface;
 mod gltf_texture;
+pub mod gltf_writer;
 mod hit_surface;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
-pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, LoadOptions, DEFAULT_ENVIRONMENT};
+pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, ArrayLimit, LoadOptions, DEFAULT_ENVIRONMENT};
 pub use gltf_material::spec_gloss_to_metal_rough;
 pub use gltf_mesh::triangle_indices;
 pub use punctual::{PunctualKind, PunctualLight};
@@ -20,12 +24,12 @@ pub use punctual::{PunctualKind, PunctualLight};
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
-use crate::bvh::Bvh;
-use crate::environment::EnvironmentMap;
 use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
-use crate::lights::build_alias_table;
-use crate::surface::TriangleSurface;
-use crate::texture::SceneTextures;
+use crate::scene::bvh::Bvh;
+use crate::scene::environment::EnvironmentMap;
+use crate::shading::lights::build_alias_table;
+use crate::shading::surface::TriangleSurface;
+use crate::shading::texture::SceneTextures;
 
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;

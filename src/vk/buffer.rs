@@ -22,6 +22,10 @@ pub enum BufferUsage {
     Params,
     /// Staging memory the host maps for uploads and readbacks.
     Staging,
+    /// A read-only scene array too large for one binding, which kernels reach by its device
+    /// address (`Buffer::device_address`); bounded by maxMemoryAllocationSize instead of
+    /// maxStorageBufferRange. Needs `DeviceInfo::buffer_device_address`.
+    Addressed,
 }
 
 pub struct Buffer {
@@ -38,6 +42,13 @@ impl Buffer {
         if usage == BufferUsage::Storage {
             ctx.check_binding_size(name, size)?;
         }
+        if usage == BufferUsage::Addressed && size > ctx.info.max_allocation_bytes {
+            return Err(GpuError::AllocationTooLarge {
+                what: name.to_string(),
+                needed: size,
+                limit: ctx.info.max_allocation_bytes,
+            });
+        }
         let (flags, location) = match usage {
             BufferUsage::Storage => (
                 vk::BufferUsageFlags::STORAGE_BUFFER
@@ -50,6 +61,10 @@ impl Buffer {
             BufferUsage::Staging => (
                 vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
+            ),
+            BufferUsage::Addressed => (
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
             ),
         };
         let info = vk::BufferCreateInfo::default()
@@ -107,9 +122,20 @@ impl Buffer {
 
     /// Creates a storage buffer holding `data`.
     pub fn from_slice<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T]) -> Result<Self, GpuError> {
-        let buffer = Self::new(ctx, name, std::mem::size_of_val(data) as u64, BufferUsage::Storage)?;
+        Self::with_data(ctx, name, data, BufferUsage::Storage)
+    }
+
+    /// Creates a buffer of `usage` holding `data`.
+    pub fn with_data<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T], usage: BufferUsage) -> Result<Self, GpuError> {
+        let buffer = Self::new(ctx, name, std::mem::size_of_val(data) as u64, usage)?;
         buffer.write(data)?;
         Ok(buffer)
+    }
+
+    /// The address kernels reach an `Addressed` buffer by (GL_EXT_buffer_reference).
+    pub fn device_address(&self) -> u64 {
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.handle);
+        unsafe { self.ctx.device.get_buffer_device_address(&info) }
     }
 
     fn mapped(&self) -> Option<&[u8]> {

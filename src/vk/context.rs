@@ -23,6 +23,10 @@ pub struct ContextOptions {
     pub device: Option<String>,
     /// Enables VK_LAYER_KHRONOS_validation and counts every message it reports.
     pub validation: bool,
+    /// Bytes past which a scene array is reached by buffer device address rather than bound
+    /// (at most maxStorageBufferRange, the default). Tests lower it so that small scenes take
+    /// the addressed path.
+    pub scene_binding_limit: Option<u64>,
 }
 
 #[derive(Debug, Clone)]
@@ -31,6 +35,14 @@ pub struct DeviceInfo {
     pub device_type: vk::PhysicalDeviceType,
     pub max_storage_buffer_range: u64,
     pub max_uniform_buffer_range: u64,
+    /// Bytes one scene array may take in a binding (maxStorageBufferRange, or less where
+    /// `ContextOptions::scene_binding_limit` says so); larger ones are addressed.
+    pub scene_binding_limit: u64,
+    /// Whether bufferDeviceAddress is enabled: scene arrays past `scene_binding_limit` are then
+    /// reached by address, bounded by `max_allocation_bytes` instead.
+    pub buffer_device_address: bool,
+    /// The largest single allocation (maxMemoryAllocationSize; lavapipe: 2 GiB).
+    pub max_allocation_bytes: u64,
     /// Bytes of shared memory a compute workgroup may use (Vulkan's floor: 16384).
     pub max_compute_shared_memory: u32,
     pub timestamp_period_ns: f32,
@@ -166,13 +178,20 @@ impl Context {
                 .map_err(vk_error("creating the debug messenger"))?;
             guard.debug = Some((loader, messenger));
         }
-        let (physical_device, queue_family, info) = pick_device(guard.instance(), options.device.as_deref())?;
+        let (physical_device, queue_family, mut info) = pick_device(guard.instance(), options.device.as_deref())?;
+        info.scene_binding_limit = options
+            .scene_binding_limit
+            .map_or(info.max_storage_buffer_range, |l| l.min(info.max_storage_buffer_range));
 
         let priorities = [1.0f32];
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
+        let mut address_features = vk::PhysicalDeviceBufferDeviceAddressFeatures::default().buffer_device_address(true);
+        let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
+        if info.buffer_device_address {
+            device_info = device_info.push_next(&mut address_features);
+        }
         let device = unsafe { guard.instance().create_device(physical_device, &device_info, None) }
             .map_err(vk_error("creating the logical device"))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -191,7 +210,7 @@ impl Context {
             device: device.clone(),
             physical_device,
             debug_settings: Default::default(),
-            buffer_device_address: false,
+            buffer_device_address: info.buffer_device_address,
             allocation_sizes: Default::default(),
         });
         let allocator = match allocator {
@@ -247,7 +266,6 @@ impl Context {
         }
     }
 
-    /// Checks a storage binding against maxStorageBufferRange before anything is allocated.
     /// The compute pipelines created on this device so far: a renderer creates all of its
     /// own at start-up, so a run's count stays put across its frames.
     pub fn pipelines_created(&self) -> u64 {
@@ -258,6 +276,23 @@ impl Context {
         self.pipelines.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
+    /// The most bytes one scene array may take: a buffer reached by device address where the
+    /// device has bufferDeviceAddress, else one storage binding.
+    pub fn scene_array_limit(&self) -> crate::scene::ArrayLimit {
+        if self.info.buffer_device_address {
+            crate::scene::ArrayLimit {
+                bytes: self.info.max_allocation_bytes,
+                name: "maxMemoryAllocationSize",
+            }
+        } else {
+            crate::scene::ArrayLimit {
+                bytes: self.info.max_storage_buffer_range,
+                name: "maxStorageBufferRange",
+            }
+        }
+    }
+
+    /// Checks a storage binding against maxStorageBufferRange before anything is allocated.
     pub fn check_binding_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
         if bytes > self.info.max_storage_buffer_range {
             return Err(GpuError::BindingTooLarge {
@@ -405,11 +440,20 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
         )
     })?;
     let props = unsafe { instance.get_physical_device_properties(chosen) };
+    let mut address_features = vk::PhysicalDeviceBufferDeviceAddressFeatures::default();
+    let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut address_features);
+    unsafe { instance.get_physical_device_features2(chosen, &mut features) };
+    let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut maintenance3);
+    unsafe { instance.get_physical_device_properties2(chosen, &mut props2) };
     let info = DeviceInfo {
         name: device_name(&props),
         device_type: props.device_type,
         max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
         max_uniform_buffer_range: props.limits.max_uniform_buffer_range as u64,
+        scene_binding_limit: props.limits.max_storage_buffer_range as u64,
+        buffer_device_address: address_features.buffer_device_address == vk::TRUE,
+        max_allocation_bytes: maintenance3.max_memory_allocation_size,
         max_compute_shared_memory: props.limits.max_compute_shared_memory_size,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamps_supported: timestamp_bits > 0 && props.limits.timestamp_compute_and_graphics == vk::TRUE,

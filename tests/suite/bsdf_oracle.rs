@@ -1,9 +1,9 @@
-//! GLSL bsdf.glsl against src/bsdf.rs: bsdf_eval_pdf and bsdf_sample on random materials,
+//! GLSL bsdf.glsl against src/shading/bsdf.rs: bsdf_eval_pdf and bsdf_sample on random materials,
 //! normals, directions and uniforms, plus sample/pdf consistency of the Rust model.
 
 use glam::{Vec3, Vec4};
-use restir_pt::bsdf::*;
 use restir_pt::gpu_types::Material;
+use restir_pt::shading::bsdf::*;
 
 use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_oracle, TestRng};
 

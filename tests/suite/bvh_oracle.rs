@@ -2,16 +2,16 @@
 //! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::bvh::{trace_closest, trace_occluded, NO_HIT};
-use restir_pt::gltf_writer::MeshData;
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
-use restir_pt::lights::sample_light;
-use restir_pt::ray_offset::offset_ray_origin;
 use restir_pt::render::{RenderSettings, SceneGpu};
+use restir_pt::scene::bvh::{trace_closest, trace_occluded, NO_HIT};
+use restir_pt::scene::gltf_writer::MeshData;
 use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
+use restir_pt::shading::lights::sample_light;
+use restir_pt::shading::ray_offset::offset_ray_origin;
 use restir_pt::vk::{Buffer, BufferUsage};
 
-use crate::common::{assert_clean, close, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, close, gpu, run_oracle_with_defines, TestRng};
 
 const RAYS: usize = 20_000;
 
@@ -57,7 +57,11 @@ fn random_scene_lit(seed: u64, lights: Vec<PunctualLight>) -> Scene {
     random_scene_full(seed, lights, None)
 }
 
-fn random_scene_full(seed: u64, lights: Vec<PunctualLight>, environment_map: Option<restir_pt::environment::EnvironmentMap>) -> Scene {
+fn random_scene_full(
+    seed: u64,
+    lights: Vec<PunctualLight>,
+    environment_map: Option<restir_pt::scene::environment::EnvironmentMap>,
+) -> Scene {
     let mut r = TestRng(seed);
     let mut triangles = Vec::new();
     for i in 0..6000 {
@@ -118,23 +122,45 @@ fn random_scene_full(seed: u64, lights: Vec<PunctualLight>, environment_map: Opt
 #[test]
 fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
     let ctx = gpu();
-    // Punctual lights share the alias table: light sampling's delta branch is compared too.
     let scene = random_scene_with_punctual_lights(1);
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(
+        !scene_gpu.uniform && !scene_gpu.addressed(),
+        "this scene is meant to exercise the storage-buffer path"
+    );
+    check_scene_oracle(&ctx, &scene, &scene_gpu, &[]);
+}
+
+/// The same comparison with the scene's triangles, BVH nodes and emitters reached by device
+/// address (SCENE_ADDRESSED), as scenes past one binding's range are: a 4 KiB binding limit
+/// sends this 6000-triangle scene down that path.
+#[test]
+fn bvh_traversal_lights_and_camera_glsl_matches_rust_addressed() {
+    let ctx = crate::common::gpu_with_scene_binding_limit(Some(4096));
+    assert!(ctx.info.buffer_device_address, "the device lacks bufferDeviceAddress");
+    let scene = random_scene_with_punctual_lights(1);
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(scene_gpu.addressed() && !scene_gpu.uniform);
+    check_scene_oracle(&ctx, &scene, &scene_gpu, &[("SCENE_ADDRESSED", "1")]);
+}
+
+/// Runs oracle/scene_oracle.comp (compiled with `defines`) over random rays and compares every
+/// output with the Rust twins.
+fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene, scene_gpu: &SceneGpu, defines: &[(&str, &str)]) {
+    // Punctual lights share the alias table: light sampling's delta branch is compared too.
     let settings = RenderSettings {
         width: 64,
         height: 48,
         ..Default::default()
     };
-    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-    assert!(!scene_gpu.uniform, "this scene is meant to exercise the storage-buffer path");
     let params = Buffer::new(
-        &ctx,
+        ctx,
         "params",
         std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(&scene)]).unwrap();
+    params.write(&[settings.frame_params(scene)]).unwrap();
 
     let mut r = TestRng(2);
     let mut inputs = Vec::with_capacity(4 * RAYS);
@@ -147,9 +173,10 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
         inputs.push(Vec4::new(r.uniform() * 64.0, r.uniform() * 48.0, 0.0, 0.0));
     }
-    let out: Vec<Vec4> = run_oracle(
-        &ctx,
+    let out: Vec<Vec4> = run_oracle_with_defines(
+        ctx,
         "oracle/scene_oracle.comp",
+        defines,
         &scene_gpu.buffers(&params),
         &[bytemuck::cast_slice(&inputs)],
         RAYS * 24,
@@ -190,7 +217,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         for k in 0..3 {
             assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
         }
-        let ls = sample_light(&scene, o.truncate(), u);
+        let ls = sample_light(scene, o.truncate(), u);
         let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
         assert!(
             dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
@@ -203,10 +230,10 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         let dir = camera.ray_dir(px.x, px.y, settings.width, settings.height);
         assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
         assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
-        if restir_pt::lights::is_punctual_light(ls.triangle) {
+        if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
             punctual_samples += 1;
             let shadowed =
-                restir_pt::lights::punctual_occluded(&scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+                restir_pt::shading::lights::punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
             assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
             punctual_shadowed += shadowed as usize;
         }
@@ -223,7 +250,7 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
         hits > RAYS / 4,
         "only {hits} of {RAYS} rays hit: the scene does not exercise traversal"
     );
-    assert_clean(&ctx);
+    assert_clean(ctx);
 }
 
 #[test]
@@ -236,7 +263,7 @@ fn bvh_closest_hit_equals_brute_force() {
         let h = trace_closest(&scene.nodes, &scene.triangles, o, d, 1e30);
         let mut best = (1e30f32, NO_HIT);
         for (k, tri) in scene.triangles.iter().enumerate() {
-            if let Some((t, _)) = restir_pt::bvh::intersect_triangle(o, d, tri, best.0) {
+            if let Some((t, _)) = restir_pt::scene::bvh::intersect_triangle(o, d, tri, best.0) {
                 best = (t, k as u32);
             }
         }
@@ -266,10 +293,10 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
 
 /// The environment half of light sampling with an equirectangular map (the scene's emitters beside
 /// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (lights.glsl, compiled
-/// with the scene's SCENE_ENV_MAP defines) against their Rust twins in src/lights.rs.
+/// with the scene's SCENE_ENV_MAP defines) against their Rust twins in src/shading/lights.rs.
 #[test]
 fn environment_map_light_sampling_glsl_matches_rust() {
-    use restir_pt::lights::{environment_pdf, environment_radiance};
+    use restir_pt::shading::lights::{environment_pdf, environment_radiance};
     let ctx = gpu();
     let scene = random_scene_full(5, vec![], Some(crate::sampling_statistics::test_environment_map()));
     assert!(scene.env_select_prob > 0.0 && scene.env_select_prob < 1.0);
@@ -325,7 +352,7 @@ fn environment_map_light_sampling_glsl_matches_rust() {
             // The map is piecewise constant: radiance and pdf must agree unless the direction
             // sits within 0.005 texels of a texel edge, where llvmpipe's atan/acos and Rust's
             // may round to different texels.
-            let uv = restir_pt::environment::equirect_uv(ls.dir) * Vec2::new(24.0, 12.0);
+            let uv = restir_pt::scene::environment::equirect_uv(ls.dir) * Vec2::new(24.0, 12.0);
             let edge = (uv - uv.round()).abs().min_element() < 5e-3;
             if edge {
                 near_edges += 1;

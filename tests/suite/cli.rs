@@ -385,7 +385,7 @@ fn cli_compare_writes_results_charts_and_strip() {
 /// A lamp of radiance 3e38 (finite, so the loader takes it) whose sums overflow to infinity.
 fn overflowing_lamp_scene() -> std::path::PathBuf {
     use glam::Vec3;
-    use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+    use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
     let mut b = GltfBuilder::default();
     let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.5)));
     let lamp = b.material("lamp", MaterialSpec::emitter(Vec3::splat(3e38)));

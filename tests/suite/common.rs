@@ -9,9 +9,16 @@ use restir_pt::vk::{Binding, Buffer, Context, ContextOptions, Kernel};
 pub const NAN_FILL: u32 = 0x7fc0_0000;
 
 pub fn gpu() -> Arc<Context> {
+    gpu_with_scene_binding_limit(None)
+}
+
+/// A validated context whose scene arrays past `limit` bytes are reached by device address
+/// (`ContextOptions::scene_binding_limit`): small scenes then take the large-scene path.
+pub fn gpu_with_scene_binding_limit(limit: Option<u64>) -> Arc<Context> {
     let ctx = Context::new(&ContextOptions {
         device: None,
         validation: true,
+        scene_binding_limit: limit,
     })
     .expect("a Vulkan device with validation layers (tools/setup.sh)");
     Arc::new(ctx)
@@ -38,6 +45,19 @@ pub fn run_oracle<T: bytemuck::Pod>(
     output_words: usize,
     count: u32,
 ) -> Vec<T> {
+    run_oracle_with_defines(ctx, kernel, &[], leading, inputs, output_words, count)
+}
+
+/// `run_oracle` with the kernel compiled with `defines`.
+pub fn run_oracle_with_defines<T: bytemuck::Pod>(
+    ctx: &Arc<Context>,
+    kernel: &str,
+    defines: &[(&str, &str)],
+    leading: &[&Buffer],
+    inputs: &[&[u8]],
+    output_words: usize,
+    count: u32,
+) -> Vec<T> {
     let input_buffers: Vec<Buffer> = inputs
         .iter()
         .enumerate()
@@ -49,7 +69,7 @@ pub fn run_oracle<T: bytemuck::Pod>(
     bindings.extend(input_buffers.iter());
     bindings.push(&output);
     let kinds = vec![Binding::Storage; bindings.len()];
-    let k = Kernel::new(ctx, kernel, &[], &kinds, 4).unwrap();
+    let k = Kernel::new(ctx, kernel, defines, &kinds, 4).unwrap();
     k.bind(&bindings);
     k.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
     let words = output.read::<u32>(output_words).unwrap();
@@ -86,7 +106,7 @@ impl TestRng {
         (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
     }
     pub fn unit_vector(&mut self) -> glam::Vec3 {
-        restir_pt::sampling::sample_uniform_sphere(glam::Vec2::new(self.uniform(), self.uniform()))
+        restir_pt::shading::sampling::sample_uniform_sphere(glam::Vec2::new(self.uniform(), self.uniform()))
     }
 }
 

@@ -5,8 +5,8 @@
 //! interface has energy 1 exactly; the single-scattering bounds are in docs/materials.md.
 
 use glam::{Vec3, Vec4};
-use restir_pt::bsdf::{bsdf_sample, index_matched, DELTA_ALPHA, LOBE_TRANSMISSION};
 use restir_pt::gpu_types::Material;
+use restir_pt::shading::bsdf::{bsdf_sample, index_matched, DELTA_ALPHA, LOBE_TRANSMISSION};
 
 use crate::common::{assert_clean, gpu, run_oracle, TestRng};
 
@@ -163,7 +163,7 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
 /// Rough (0.5) glass of IOR `ior` as a quad facing the camera or as a sphere, in a uniform
 /// environment of radiance 1: the reproduction of IOR 1.
 fn glass_furnace_scene(ior: f32, sphere: bool) -> restir_pt::scene::Scene {
-    use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+    use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
     let mut b = GltfBuilder::default();
     let glass = b.material("glass", MaterialSpec::glass(ior, 0.5));
     let mesh = if sphere {

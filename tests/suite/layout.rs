@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use restir_pt::gpu_types::{
     BvhNode, Emitter, FrameParams, Material, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface, Triangle,
 };
-use restir_pt::path_record::PathRecord;
+use restir_pt::shading::path_record::PathRecord;
 use restir_pt::vk::compile_kernel;
 
 const OP_NAME: u32 = 5;

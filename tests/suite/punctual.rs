@@ -9,10 +9,10 @@
 //! which a wrong Jacobian, MIS weight or light pdf would miss.
 
 use glam::Vec3;
-use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
-use restir_pt::lights::spot_falloff;
 use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ShiftKind};
+use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::scene::{load_scene, Scene};
+use restir_pt::shading::lights::spot_falloff;
 use serde_json::{json, Value};
 
 use crate::common::{assert_clean, gpu, temp_file};

@@ -1,7 +1,7 @@
-//! GLSL rng.glsl against src/rng.rs: pcg4d, path_seed and rng_uniform4 must agree bit for bit.
+//! GLSL rng.glsl against src/shading/rng.rs: pcg4d, path_seed and rng_uniform4 must agree bit for bit.
 
 use glam::UVec4;
-use restir_pt::rng::{path_seed, pcg4d, rng_uniform4};
+use restir_pt::shading::rng::{path_seed, pcg4d, rng_uniform4};
 
 use crate::common::{assert_clean, gpu, run_oracle, TestRng};
 

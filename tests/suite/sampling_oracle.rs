@@ -1,7 +1,7 @@
-//! GLSL sampling.glsl against src/sampling.rs on random uniforms and directions.
+//! GLSL sampling.glsl against src/shading/sampling.rs on random uniforms and directions.
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::sampling::*;
+use restir_pt::shading::sampling::*;
 
 use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_oracle, TestRng};
 

@@ -4,10 +4,10 @@
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use restir_pt::bsdf::{ggx_vndf_pdf, smith_g1};
-use restir_pt::bvh::intersect_triangle;
-use restir_pt::lights::{alias_select, sample_light};
-use restir_pt::sampling::{sample_cosine_hemisphere, sample_ggx_vndf, sample_triangle};
+use restir_pt::scene::bvh::intersect_triangle;
+use restir_pt::shading::bsdf::{ggx_vndf_pdf, smith_g1};
+use restir_pt::shading::lights::{alias_select, sample_light};
+use restir_pt::shading::sampling::{sample_cosine_hemisphere, sample_ggx_vndf, sample_triangle};
 
 use crate::common::TestRng;
 
@@ -198,7 +198,7 @@ fn sample_light_pdf_is_consistent_with_solid_angle() {
 
 /// A 24 x 12 map with a sky gradient, a bright 2 x 1-texel sun and a black band, so that the
 /// luminance density is far from uniform.
-pub fn test_environment_map() -> restir_pt::environment::EnvironmentMap {
+pub fn test_environment_map() -> restir_pt::scene::environment::EnvironmentMap {
     let (w, h) = (24u32, 12u32);
     let texels = (0..w * h)
         .map(|k| {
@@ -212,7 +212,7 @@ pub fn test_environment_map() -> restir_pt::environment::EnvironmentMap {
             }
         })
         .collect();
-    restir_pt::environment::EnvironmentMap::new(w, h, texels).unwrap()
+    restir_pt::scene::environment::EnvironmentMap::new(w, h, texels).unwrap()
 }
 
 /// Environment-map importance sampling: the texel counts of a million samples against
@@ -222,7 +222,7 @@ pub fn test_environment_map() -> restir_pt::environment::EnvironmentMap {
 /// standard errors).
 #[test]
 fn environment_map_sampling_chi_square_and_pdf() {
-    use restir_pt::environment::equirect_uv;
+    use restir_pt::scene::environment::equirect_uv;
     let map = test_environment_map();
     let (w, h) = (map.width as usize, map.height as usize);
     let weight: Vec<f64> = (0..w * h)
@@ -235,7 +235,7 @@ fn environment_map_sampling_chi_square_and_pdf() {
     let mut observed = vec![0.0; w * h];
     let mut r = TestRng(91);
     for _ in 0..SAMPLES {
-        let d = map.sample(Vec2::new(r.uniform(), r.uniform()));
+        let d = map.sample_environment(Vec2::new(r.uniform(), r.uniform()));
         assert!((d.length() - 1.0).abs() < 1e-4);
         let uv = equirect_uv(d);
         let (i, j) = (((uv.y * h as f32) as usize).min(h - 1), ((uv.x * w as f32) as usize).min(w - 1));

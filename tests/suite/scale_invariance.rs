@@ -5,8 +5,8 @@
 //! vertices lose nothing and any difference is the renderer's.
 
 use glam::{DVec3, Vec3};
-use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings};
+use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
 use serde_json::{json, Value};
 

@@ -2,7 +2,7 @@
 //! that names the file.
 
 use glam::Vec3;
-use restir_pt::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::scene::load_scene;
 use serde_json::{json, Value};
 

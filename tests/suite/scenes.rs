@@ -1,8 +1,8 @@
 //! The bundled scenes: committed files equal the generator's output, the README's table matches
 //! the loaded scenes, and every scene renders to a finite, non-black image.
 
-use restir_pt::bundled_scenes::BUNDLED_SCENES;
 use restir_pt::render::{PathTracer, RenderSettings};
+use restir_pt::scene::bundled_scenes::BUNDLED_SCENES;
 use restir_pt::scene::load_scene;
 
 use crate::common::{assert_clean, gpu, repo_path};

@@ -1,28 +1,29 @@
-//! The shift mappings' Rust reference (src/shift.rs) on the bundled scenes: round trips,
-//! reciprocal Jacobians, finite-difference Jacobians, injectivity and clean failure.
+//! The shift mappings' Rust reference (src/shading/shift.rs) on the bundled scenes: round trips,
+//! reciprocal Jacobians, finite-difference Jacobians, injectivity and clean failure; the GLSL
+//! twins against it are in shift_oracle.rs.
 //! `cargo test --release shift` runs them all.
 
 use std::collections::HashSet;
 
 use glam::Vec3;
-use restir_pt::path_record::PathRecord;
 use restir_pt::scene::{load_scene, Scene};
-use restir_pt::shift::*;
+use restir_pt::shading::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord};
+use restir_pt::shading::shift::*;
 
 use crate::common::{repo_path, TestRng};
 
 const IMAGE: u32 = 64;
 const RADIUS: f32 = 20.0;
-const BASE_PATHS: usize = 10_000;
+pub(crate) const BASE_PATHS: usize = 10_000;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Kind {
+pub(crate) enum Kind {
     Reconnection,
     RandomReplay,
     Hybrid,
 }
 
-fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
+pub(crate) fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
     match kind {
         Kind::Reconnection => shift_reconnection(scene, params, base, camera, y1),
         Kind::RandomReplay => shift_random_replay(scene, params, base, camera, y1),
@@ -30,7 +31,7 @@ fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &PathRecord, cam
     }
 }
 
-fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
+pub(crate) fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
     match kind {
         Kind::Reconnection => inverse_reconnection(scene, params, shifted, camera, x1),
         Kind::RandomReplay => inverse_random_replay(scene, params, shifted, camera, x1),
@@ -39,13 +40,13 @@ fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &PathRecord
 }
 
 /// A base path in a random pixel of camera 0 and the primary hit of a neighbour within RADIUS.
-struct Case {
-    base: Path,
-    record: PathRecord,
-    y1: Vertex,
+pub(crate) struct Case {
+    pub base: Path,
+    pub record: PathRecord,
+    pub y1: Vertex,
 }
 
-fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
+pub(crate) fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
     let params = ShiftParams::for_scene(scene);
     let mut r = TestRng(seed);
     let mut out = Vec::with_capacity(count);
@@ -283,11 +284,11 @@ fn check_jacobian_finite_difference(kind: Kind) {
             };
             let r = reconnection_index(&scene, &case.base, &params).unwrap();
             let x_r = case.base.vertices[r - 1];
-            if x_r.is_escaped() {
+            if vertex_is_escaped(&x_r) {
                 continue;
             }
             let p = x_r.pos.as_dvec3();
-            let (t1, t2) = restir_pt::sampling::build_onb(x_r.normal);
+            let (t1, t2) = restir_pt::shading::sampling::build_onb(x_r.normal);
             let (a, b) = (p + h * t1.as_dvec3(), p + h * t2.as_dvec3());
             let omega_y = solid_angle(y.vertices[r - 2].pos.as_dvec3(), p, a, b);
             let omega_x = solid_angle(case.base.vertices[r - 2].pos.as_dvec3(), p, a, b);
@@ -323,193 +324,16 @@ fn shift_path_record_is_80_bytes_and_packs_its_fields() {
         lobes,
         ..Default::default()
     };
-    assert_eq!((record.length(), record.reconnection_index(), record.nee_end()), (6, Some(3), true));
-    assert_eq!((1..=5).map(|i| record.lobe(i)).collect::<Vec<_>>(), vec![1, 2, 12, 20, 0]);
     assert_eq!(
-        PathRecord {
-            info: PathRecord::pack_info(2, None, false),
-            ..Default::default()
-        }
-        .reconnection_index(),
-        None
+        (record_length(&record), record_reconnection_index(&record), record_nee_end(&record)),
+        (6, Some(3), true)
     );
-}
-
-/// Whether the Rust shift's validity changes when either threshold moves by 1e-3 (relative):
-/// the input is then within 1e-3 of a threshold, where GPU and CPU rounding may disagree.
-fn near_threshold(kind: Kind, scene: &Scene, params: &ShiftParams, case: &Case, camera: Vec3, valid: bool) -> bool {
-    [(1.0 + 1e-3, 1.0), (1.0 - 1e-3, 1.0), (1.0, 1.0 + 1e-3), (1.0, 1.0 - 1e-3)]
-        .iter()
-        .any(|&(fr, fd)| {
-            let moved = ShiftParams {
-                roughness_threshold: params.roughness_threshold * fr,
-                distance_threshold: params.distance_threshold * fd,
-            };
-            shift(kind, scene, &moved, &case.record, camera, case.y1).valid != valid
-        })
-}
-
-/// GLSL glsl/shift.glsl against src/shift.rs: 10^4 base paths per scene, each shifted on the GPU
-/// and in Rust. Validity, the rebuilt vertices (within 1e-4 of the scene's extent), the Jacobian
-/// and the contribution agree within 1e-4 relative (random replay: within 1e-3, and at most 0.1%
-/// beyond 1e-4), the record's cached terms within 1e-3. Inputs within 1e-3 of the distance or
-/// roughness threshold are excluded and counted (at most 1%).
-fn check_glsl_matches_rust(kind: Kind) {
-    use glam::Vec4;
-    use restir_pt::render::{RenderSettings, SceneGpu};
-    use restir_pt::vk::{Buffer, BufferUsage};
-    let ctx = crate::common::gpu();
-    for name in ["cornell", "cornell-glossy", "glass", "near-field"] {
-        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
-        let params = ShiftParams::for_scene(&scene);
-        let camera = scene.cameras[0].position;
-        let cases = cases(&scene, 4321, BASE_PATHS);
-        let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-        let frame = Buffer::new(
-            &ctx,
-            "params",
-            std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
-            BufferUsage::Params,
-        )
-        .unwrap();
-        frame.write(&[RenderSettings::default().frame_params(&scene)]).unwrap();
-        let kind_index = match kind {
-            Kind::Reconnection => 0u32,
-            Kind::RandomReplay => 1,
-            Kind::Hybrid => 2,
-        };
-        let shift_params = [
-            kind_index,
-            params.roughness_threshold.to_bits(),
-            params.distance_threshold.to_bits(),
-            0,
-        ];
-        let records: Vec<PathRecord> = cases.iter().map(|c| c.record).collect();
-        let targets: Vec<Vec4> = cases
-            .iter()
-            .flat_map(|c| [c.y1.pos.extend(f32::from_bits(c.y1.triangle)), camera.extend(0.0)])
-            .collect();
-        let out: Vec<Vec4> = crate::common::run_oracle(
-            &ctx,
-            "oracle/shift_oracle.comp",
-            &scene_gpu.buffers(&frame),
-            &[
-                bytemuck::cast_slice(&shift_params),
-                bytemuck::cast_slice(&records),
-                bytemuck::cast_slice(&targets),
-            ],
-            cases.len() * 13 * 4,
-            cases.len() as u32,
-        );
-        let close = |a: f32, b: f32, tol: f32| (a - b).abs() <= tol * a.abs().max(b.abs()).max(1e-30);
-        let (mut excluded, mut compared, mut beyond_1e4) = (0, 0, 0);
-        for (i, case) in cases.iter().enumerate() {
-            let g = &out[13 * i..13 * i + 13];
-            let rust = shift(kind, &scene, &params, &case.record, camera, case.y1);
-            let gpu_valid = g[0].x == 1.0;
-            if gpu_valid != rust.valid {
-                assert!(
-                    near_threshold(kind, &scene, &params, case, camera, rust.valid),
-                    "{name} {kind:?} case {i}: GLSL valid {gpu_valid}, Rust valid {}",
-                    rust.valid
-                );
-                excluded += 1;
-                continue;
-            }
-            if !rust.valid {
-                assert!(
-                    g[0].y == 0.0 && g[5].truncate() == Vec3::ZERO,
-                    "{name} {kind:?} case {i}: a failed GLSL shift carries a value"
-                );
-                continue;
-            }
-            // Float fields only: the record's uint fields travel as float bits.
-            let floats = [g[0].truncate(), g[2].truncate(), g[3].truncate(), g[4].truncate(), g[5].truncate()];
-            let scalars = [g[2].w, g[3].w, g[4].w];
-            assert!(
-                floats.iter().all(|v| !v.is_nan()) && scalars.iter().all(|x| !x.is_nan()),
-                "{name} {kind:?} case {i}: NaN in the GLSL output {g:?}"
-            );
-            compared += 1;
-            let r = &rust.record;
-            assert_eq!(
-                [
-                    g[1].x.to_bits(),
-                    g[1].y.to_bits(),
-                    g[1].z.to_bits(),
-                    g[1].w.to_bits(),
-                    g[5].w.to_bits()
-                ],
-                [r.seed, r.info, r.lobes, r.rc_triangle, r.rc_next_triangle],
-                "{name} {kind:?} case {i}: record header"
-            );
-            assert!(
-                close(g[0].y, rust.jacobian, 1e-4),
-                "{name} {kind:?} case {i}: jacobian GLSL {} vs Rust {}",
-                g[0].y,
-                rust.jacobian
-            );
-            // The record's cached terms (single pdfs and cosines, not the ratios the Jacobian
-            // uses) of a path replayed over several bounces carry the bounces' rounding; at
-            // grazing angles that reaches 1e-4.
-            let cached = [
-                ("rc_pdf", g[2].w, r.rc_pdf),
-                ("rc_geometry", g[3].w, r.rc_geometry),
-                ("rc_pdf_after", g[4].w, r.rc_pdf_after),
-            ];
-            for (what, a, b) in cached {
-                assert!(close(a, b, 1e-3), "{name} {kind:?} case {i}: {what} GLSL {a} vs Rust {b}");
-            }
-            let scale = rust.contribution.max_element();
-            let worst = (0..3)
-                .map(|c| (g[5][c] - rust.contribution[c]).abs() / scale)
-                .fold(0.0f32, f32::max);
-            // Replay regenerates whole paths on two different math libraries. Where an NEE end
-            // sees its light nearly edge-on, f(X) is proportional to that cosine and inherits the
-            // rounding of the regenerated positions: about 1 path in 10^4 reaches 2e-4. Replay is
-            // held to 1e-3 and at most 0.1% beyond 1e-4, counted; the others to 1e-4.
-            let bound = if kind == Kind::RandomReplay { 1e-3 } else { 1e-4 };
-            assert!(
-                worst <= bound,
-                "{name} {kind:?} case {i}: contribution GLSL {} vs Rust {} ({worst:e})",
-                g[5],
-                rust.contribution
-            );
-            beyond_1e4 += (worst > 1e-4) as usize;
-            assert_eq!(g[0].z as usize, rust.vertices.len(), "{name} {kind:?} case {i}: vertex count");
-            for (v, rv) in rust.vertices.iter().enumerate() {
-                let gv = g[6 + v].truncate();
-                assert!(
-                    (gv - rv.pos).length() <= 1e-4 * scene.extent(),
-                    "{name} {kind:?} case {i}: vertex {v} GLSL {gv} vs Rust {}",
-                    rv.pos
-                );
-            }
-        }
-        eprintln!("{name} {kind:?}: {compared} valid shifts compared, {excluded} within 1e-3 of a threshold excluded, {beyond_1e4} contributions beyond 1e-4");
-        assert!(
-            beyond_1e4 * 1000 <= compared,
-            "{name} {kind:?}: {beyond_1e4} contributions beyond 1e-4"
-        );
-        assert!(excluded * 100 <= cases.len(), "{name} {kind:?}: {excluded} exclusions");
-        assert!(compared > cases.len() / 10, "{name} {kind:?}: only {compared} valid shifts");
-    }
-    crate::common::assert_clean(&ctx);
-}
-
-#[test]
-fn shift_reconnection_glsl_matches_rust() {
-    check_glsl_matches_rust(Kind::Reconnection);
-}
-
-#[test]
-fn shift_random_replay_glsl_matches_rust() {
-    check_glsl_matches_rust(Kind::RandomReplay);
-}
-
-#[test]
-fn shift_hybrid_glsl_matches_rust() {
-    check_glsl_matches_rust(Kind::Hybrid);
+    assert_eq!((1..=5).map(|i| record_lobe(&record, i)).collect::<Vec<_>>(), vec![1, 2, 12, 20, 0]);
+    let unconnected = PathRecord {
+        info: PathRecord::pack_info(2, None, false),
+        ..Default::default()
+    };
+    assert_eq!(record_reconnection_index(&unconnected), None);
 }
 
 /// The reconnection y1 -> x2 checked from the geometry alone, with the public BVH and BSDF:
@@ -524,9 +348,9 @@ struct Causes {
 
 #[test]
 fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
-    use restir_pt::bsdf::{bsdf_eval_pdf, lobe_weights};
-    use restir_pt::bvh::trace_occluded;
-    use restir_pt::ray_offset::offset_ray_origin;
+    use restir_pt::scene::bvh::trace_occluded;
+    use restir_pt::shading::bsdf::{bsdf_eval_pdf, lobe_weights};
+    use restir_pt::shading::ray_offset::offset_ray_origin;
     let mut total = Causes::default();
     let mut diverged = 0;
     for name in ["mirror", "glass", "near-field", "cornell", "veach-door"] {
@@ -539,7 +363,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
             let is_delta = |v: &Vertex| {
                 let m = material(v);
                 let (_, w_c, w_t) = lobe_weights(&m);
-                (w_c > 0.0 || w_t > 0.0) && m.roughness * m.roughness < restir_pt::bsdf::DELTA_ALPHA
+                (w_c > 0.0 || w_t > 0.0) && m.roughness * m.roughness < restir_pt::shading::bsdf::DELTA_ALPHA
             };
             let check = |result: &ShiftResult, what: &str| {
                 assert!(
@@ -548,7 +372,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
                 );
             };
             let rec = shift_reconnection(&scene, &params, &case.record, camera, y1);
-            if case.base.length() >= 2 && !case.base.vertices[1].is_escaped() {
+            if case.base.length() >= 2 && !vertex_is_escaped(&case.base.vertices[1]) {
                 let x2 = case.base.vertices[1];
                 let d = x2.pos - y1.pos;
                 let dir = d.normalize();

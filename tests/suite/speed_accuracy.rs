@@ -2,9 +2,8 @@
 //! energy within 2% of the references) and `compare`'s files.
 
 use glam::Vec3;
-use restir_pt::cli::{equal_time_lines, stability, CameraMotion, CompareRow, DeviceArgs, StabilityArgs, SweepMode};
+use restir_pt::cli::{equal_time_lines, parse_args, stability, CameraMotion, CompareRow, StabilityArgs};
 use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
-use restir_pt::render::RestirSettings;
 
 use crate::common::{repo_path, temp_file};
 
@@ -73,26 +72,31 @@ fn compare_equal_time_leaves_out_runs_over_budget() {
 #[test]
 fn stability_small_run_is_finite_and_keeps_energy_within_2_percent() {
     let out = temp_file("placeholder", b"").parent().unwrap().join("stability");
-    let rows = stability(StabilityArgs {
-        scenes: vec![repo_path("scenes/cornell.gltf")],
-        methods: vec!["pt".into(), "restir:hybrid".into()],
-        frames: 16,
-        width: 64,
-        height: 64,
-        max_depth: 7,
-        reference_spp: 256,
-        pt_spp: 4,
-        seed: 3,
-        restir: RestirSettings::default(),
-        out_dir: Some(out.clone()),
-        sweep: SweepMode::All,
-        argv: vec![],
-        device: DeviceArgs {
-            device: None,
-            validate: true,
-        },
-    })
+    let args: StabilityArgs = parse_args(&[
+        "--scenes",
+        repo_path("scenes/cornell.gltf").to_str().unwrap(),
+        "--methods",
+        "pt,restir:hybrid",
+        "--frames",
+        "16",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--max-depth",
+        "7",
+        "--reference-spp",
+        "256",
+        "--pt-spp",
+        "4",
+        "--seed",
+        "3",
+        "--out-dir",
+        out.to_str().unwrap(),
+        "--validate",
+    ])
     .unwrap();
+    let rows = stability(args).unwrap();
     assert_eq!(rows.len(), 2 * 2 * 16);
     assert!(rows.iter().all(|r| r.nonfinite_pixels == 0));
     for method in ["pt", "restir:hybrid/gbh"] {

@@ -7,8 +7,8 @@ use glam::{Vec2, Vec3, Vec4};
 use restir_pt::gpu_types::{FrameParams, Material, Triangle, NO_EMITTER};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
-use restir_pt::surface::{surface_at, triangle_bary, TriangleSurface};
-use restir_pt::texture::{
+use restir_pt::shading::surface::{surface_at, triangle_bary, TriangleSurface};
+use restir_pt::shading::texture::{
     normal_mapped, texture_coordinates, texture_lookup, textured_material, MaterialTextures, SceneTextures, TextureHeader, TextureSlot,
     NO_TEXTURE, TEXTURE_NEAREST,
 };
@@ -40,7 +40,7 @@ fn random_textures(r: &mut TestRng) -> SceneTextures {
         if r.uniform() < 0.2 {
             return TextureSlot::default();
         }
-        let (u_row, v_row) = restir_pt::texture::texture_transform_rows(
+        let (u_row, v_row) = restir_pt::shading::texture::texture_transform_rows(
             [r.uniform() - 0.5, r.uniform() - 0.5],
             (r.uniform() - 0.5) * 6.0,
             [0.2 + 2.0 * r.uniform(), 0.2 + 2.0 * r.uniform()],
@@ -165,7 +165,7 @@ fn compare_surfaces(scene: &Scene) {
     let mut inputs: Vec<Vec4> = Vec::with_capacity(3 * ITEMS);
     for _ in 0..ITEMS {
         let tri = (r.uniform() * scene.triangles.len() as f32) as u32 % scene.triangles.len() as u32;
-        let b = restir_pt::sampling::sample_triangle(Vec2::new(r.uniform(), r.uniform()));
+        let b = restir_pt::shading::sampling::sample_triangle(Vec2::new(r.uniform(), r.uniform()));
         let texture = (r.uniform() * textures as f32) as u32 % textures as u32;
         let t = &scene.triangles[tri as usize];
         let p = Vec3::from(t.v0) + b.x * Vec3::from(t.e1) + b.y * Vec3::from(t.e2);

@@ -1,12 +1,12 @@
-//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (src/bvh.rs), in
+//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (src/scene/bvh.rs), in
 //! both forms: the BVH traversed once for a closest-hit and a shadow ray, and the brute-force
 //! pass of small uniform-buffer scenes; and the twin against `trace_closest`/`trace_occluded`.
 
 use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
-use restir_pt::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::render::{RenderSettings, SceneGpu};
+use restir_pt::scene::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::scene::{load_scene, Scene};
 use restir_pt::vk::{Buffer, BufferUsage, Context, Kernel};
 
@@ -100,6 +100,21 @@ fn assert_gpu_matches_twin(scene: &Scene, gpu_hits: &[(Hit, bool)], pairs: &[(Pa
         }
     }
     hits
+}
+
+/// GLSL `trace_pair` against its twin with the scene's triangles and BVH nodes reached by device
+/// address (SCENE_ADDRESSED), as scenes past one binding's range are: a 4 KiB binding limit sends
+/// this 6000-triangle scene down that path.
+#[test]
+fn trace_pair_glsl_matches_rust_bvh_addressed() {
+    let ctx = crate::common::gpu_with_scene_binding_limit(Some(4096));
+    let big = random_scene(5);
+    assert!(SceneGpu::upload(&ctx, &big).unwrap().addressed());
+    let pairs = random_pairs(6, Vec3::ZERO, 6.0);
+    let gpu_hits = run_gpu(&ctx, &big, false, &pairs);
+    let hits = assert_gpu_matches_twin(&big, &gpu_hits, &pairs, false);
+    assert!(hits > PAIRS / 4, "only {hits} of {PAIRS} closest rays hit");
+    assert_clean(&ctx);
 }
 
 #[test]

@@ -1,0 +1,55 @@
+#version 460
+// Oracle kernel: the resampling MIS weights (gris.glsl, MIS_MODE as compiled) and the streaming
+// resampler (reservoir.glsl) on inputs the host recorded, one resampling per item
+// (twins: src/shading/gris.rs mis_weight, resampler_begin, resampler_offer, resampler_finish).
+#extension GL_GOOGLE_include_directive : require
+layout(local_size_x = 64) in;
+
+#include "../gris.glsl"
+#include "../reservoir.glsl"
+
+// Per item: the number of inputs n, their confidences c_l, and for each input i the row
+// p̂_{<-l}(y_i), l = 0..n-1.
+layout(std430, set = 0, binding = 0) readonly buffer Counts { uint counts[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Confidences { float case_confidences[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Targets { float case_targets[]; };
+// Per item and input, 2 vec4: (contribution, p̂), (resampling weight w, u, 1 if recording the
+// candidate fails, 0).
+layout(std430, set = 0, binding = 3) readonly buffer Offers { vec4 offers[]; };
+// Per item, 4 vec4: m_0..m_3, m_4..m_7, (m_8, the chosen input or -1, W, M), (expected, 0).
+layout(std430, set = 0, binding = 4) writeonly buffer Outputs { vec4 outputs[]; };
+layout(push_constant) uniform Push { uint count; };
+
+const uint OUT_STRIDE = 4u;
+
+void main() {
+    uint item = gl_GlobalInvocationID.x;
+    if (item >= count) return;
+    uint n = counts[item];
+    for (uint l = 0u; l < n; ++l) confidences[l] = case_confidences[MAX_INPUTS * item + l];
+    float m[MAX_INPUTS];
+    for (uint i = 0u; i < MAX_INPUTS; ++i) m[i] = 0.0;
+    Resampler s = resampler_begin();
+    for (uint i = 0u; i < n; ++i) {
+        for (uint l = 0u; l < n; ++l) targets_from[l] = case_targets[MAX_INPUTS * (MAX_INPUTS * item + i) + l];
+        m[i] = mis_weight(n, i);
+        s.confidence += confidences[i];
+        vec4 a = offers[2u * (MAX_INPUTS * item + i)];
+        float w = offers[2u * (MAX_INPUTS * item + i) + 1u].x;
+        float u = offers[2u * (MAX_INPUTS * item + i) + 1u].y;
+        if (!(w > 0.0)) continue;
+        PathRecord y = reservoir_empty().record;
+        y.seed = i;
+        y.contribution = a.xyz;
+        resampler_add(s, y, a.w, w, u);
+    }
+    bool chose = s.weight_sum > 0.0;
+    // As record_chosen does when the chosen path cannot be recorded.
+    if (chose && offers[2u * (MAX_INPUTS * item + s.chosen.seed) + 1u].z != 0.0) s.chosen_lost = true;
+    Reservoir r = resampler_finish(s);
+    uint o = OUT_STRIDE * item;
+    outputs[o] = vec4(m[0], m[1], m[2], m[3]);
+    outputs[o + 1u] = vec4(m[4], m[5], m[6], m[7]);
+    outputs[o + 2u] = vec4(m[8], chose ? float(r.record.seed) : -1.0, r.W, r.M);
+    outputs[o + 3u] = vec4(s.expected, 0.0);
+}

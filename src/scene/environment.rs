@@ -1,0 +1,204 @@
+//! Equirectangular environment maps (`--env FILE.exr|FILE.hdr`), importance-sampled by luminance:
+//! a texel is chosen with probability proportional to its luminance times sin θ (its solid
+//! angle), then a direction uniformly in its (u, v) rectangle (pbrt-v4's piecewise-constant 2D
+//! distribution, "Sampling Light Sources"). Twin of the environment half of glsl/lights.glsl.
+//!
+//! Mapping: u = 0.5 + atan2(d.x, -d.z) / 2π across the image (its centre column looks along -Z,
+//! glTF's forward), v = acos(d.y) / π down it (the top row is +Y). The radiance of a direction is
+//! its texel's (no filtering), so the pdf and the radiance are constant per texel together.
+
+use std::f32::consts::PI;
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Result};
+use glam::{Vec2, Vec3};
+
+use crate::gpu_types::Emitter;
+use crate::scene::luminance;
+
+/// An equirectangular map with its sampling tables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvironmentMap {
+    pub width: u32,
+    pub height: u32,
+    /// Radiance, row-major from the top row (+Y).
+    pub texels: Vec<Vec3>,
+    /// Marginal CDF over rows: `row_cdf[i]` is the probability of rows 0..=i (the last is 1).
+    pub row_cdf: Vec<f32>,
+    /// Conditional CDF within each row: `texel_cdf[i * width + j]` is the probability of texels
+    /// 0..=j given row i.
+    pub texel_cdf: Vec<f32>,
+}
+
+/// The (u, v) of direction `d` (unit) in [0, 1]². Twin of GLSL `equirect_uv`.
+pub fn equirect_uv(d: Vec3) -> Vec2 {
+    Vec2::new(0.5 + d.x.atan2(-d.z) / (2.0 * PI), d.y.clamp(-1.0, 1.0).acos() / PI)
+}
+
+/// The unit direction of (u, v). Twin of GLSL `equirect_dir`.
+pub fn equirect_dir(uv: Vec2) -> Vec3 {
+    let phi = (uv.x - 0.5) * 2.0 * PI;
+    let theta = uv.y * PI;
+    let s = theta.sin();
+    Vec3::new(s * phi.sin(), theta.cos(), -s * phi.cos())
+}
+
+/// The first index whose CDF value exceeds `u` (the last if none).
+/// Twin of GLSL `cdf_search`.
+fn cdf_search(cdf: &[f32], u: f32) -> usize {
+    let (mut lo, mut hi) = (0usize, cdf.len() - 1);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if cdf[mid] > u {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    lo
+}
+
+impl EnvironmentMap {
+    /// Builds the sampling tables; fails if no texel has positive luminance where sin θ > 0.
+    pub fn new(width: u32, height: u32, texels: Vec<Vec3>) -> Result<Self> {
+        let (w, h) = (width as usize, height as usize);
+        if w == 0 || h == 0 || texels.len() != w * h {
+            bail!("an environment map needs width x height texels");
+        }
+        if texels.iter().any(|t| !t.is_finite() || t.min_element() < 0.0) {
+            bail!("the environment map has negative, NaN or infinite texels");
+        }
+        let weight: Vec<f64> = (0..w * h)
+            .map(|k| {
+                let theta = PI * ((k / w) as f32 + 0.5) / h as f32;
+                luminance(texels[k]) as f64 * theta.sin() as f64
+            })
+            .collect();
+        let total: f64 = weight.iter().sum();
+        if !(total > 0.0) {
+            bail!("the environment map is black");
+        }
+        let mut row_cdf = Vec::with_capacity(h);
+        let mut texel_cdf = Vec::with_capacity(w * h);
+        let mut acc_rows = 0.0f64;
+        for i in 0..h {
+            let row = &weight[i * w..(i + 1) * w];
+            let row_sum: f64 = row.iter().sum();
+            let mut acc = 0.0f64;
+            for &x in row {
+                acc += x;
+                texel_cdf.push(if row_sum > 0.0 {
+                    (acc / row_sum) as f32
+                } else {
+                    (texel_cdf.len() % w + 1) as f32 / w as f32
+                });
+            }
+            // Rounding must not leave the last entry below 1: a u near 1 would find no texel.
+            *texel_cdf.last_mut().expect("w > 0") = 1.0;
+            acc_rows += row_sum;
+            row_cdf.push((acc_rows / total) as f32);
+        }
+        *row_cdf.last_mut().expect("h > 0") = 1.0;
+        Ok(Self {
+            width,
+            height,
+            texels,
+            row_cdf,
+            texel_cdf,
+        })
+    }
+
+    /// Reads an OpenEXR (`.exr`) or Radiance (`.hdr`) file of linear RGB radiance.
+    pub fn load(path: &Path) -> Result<Self> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let (width, height, texels) = match ext.as_deref() {
+            Some("exr") => crate::image_io::read_exr(path)?,
+            Some("hdr") => {
+                let img = image::ImageReader::open(path)
+                    .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?
+                    .with_guessed_format()
+                    .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?
+                    .decode()
+                    .map_err(|e| anyhow!("{}: not a readable Radiance HDR file: {e}", path.display()))?
+                    .into_rgb32f();
+                let (w, h) = img.dimensions();
+                (w, h, img.pixels().map(|p| Vec3::from(p.0)).collect())
+            }
+            _ => bail!("{}: an environment map must be .exr or .hdr", path.display()),
+        };
+        Self::new(width, height, texels).map_err(|e| anyhow!("{}: {e}", path.display()))
+    }
+
+    /// (row, column) of the texel holding (u, v).
+    fn env_texel_of(&self, uv: Vec2) -> (usize, usize) {
+        let j = ((uv.x * self.width as f32) as usize).min(self.width as usize - 1);
+        let i = ((uv.y * self.height as f32) as usize).min(self.height as usize - 1);
+        (i, j)
+    }
+
+    /// The probability of texel (i, j), from the CDFs that [`Self::sample_environment`] inverts.
+    fn env_texel_probability(&self, i: usize, j: usize) -> f32 {
+        let w = self.width as usize;
+        let row = self.row_cdf[i] - if i > 0 { self.row_cdf[i - 1] } else { 0.0 };
+        let k = i * w + j;
+        let texel = self.texel_cdf[k] - if j > 0 { self.texel_cdf[k - 1] } else { 0.0 };
+        row * texel
+    }
+
+    /// The radiance arriving from direction `d` (unit): the map's part of
+    /// `lights::environment_radiance`, the twin of GLSL `environment_radiance`.
+    pub fn radiance(&self, d: Vec3) -> Vec3 {
+        let (i, j) = self.env_texel_of(equirect_uv(d));
+        self.texels[i * self.width as usize + j]
+    }
+
+    /// The solid-angle density of [`Self::sample_environment`] at direction `d` (unit): the texel's
+    /// probability times its (u, v) area's inverse, over the map's Jacobian 2π² sin θ.
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        let uv = equirect_uv(d);
+        // From x and z, not 1 - y²: near the poles y rounds to ±1 while x and z keep sin θ.
+        let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+        if sin_theta <= 0.0 {
+            return 0.0;
+        }
+        let (i, j) = self.env_texel_of(uv);
+        let p_uv = self.env_texel_probability(i, j) * (self.width * self.height) as f32;
+        p_uv / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// A direction chosen by luminance with `u` in [0, 1)²: a row by the marginal CDF, a texel
+    /// by the row's CDF, then a uniform point of the texel (the CDF's leftover fractions).
+    pub fn sample_environment(&self, u: Vec2) -> Vec3 {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let i = cdf_search(&self.row_cdf, u.x);
+        let below = if i > 0 { self.row_cdf[i - 1] } else { 0.0 };
+        let fu = ((u.x - below) / (self.row_cdf[i] - below).max(f32::MIN_POSITIVE)).clamp(0.0, 0.999_999_9);
+        let row = &self.texel_cdf[i * w..(i + 1) * w];
+        let j = cdf_search(row, u.y);
+        let left = if j > 0 { row[j - 1] } else { 0.0 };
+        let fv = ((u.y - left) / (row[j] - left).max(f32::MIN_POSITIVE)).clamp(0.0, 0.999_999_9);
+        equirect_dir(Vec2::new((j as f32 + fv) / w as f32, (i as f32 + fu) / h as f32))
+    }
+
+    /// The rows after the punctual lights in the emitter buffer (glsl/types.glsl): a header
+    /// (width, 0, 0, height), the row CDF (one per row), then per texel (r, g, b, row CDF value).
+    pub fn gpu_rows(&self) -> Vec<Emitter> {
+        let header = Emitter {
+            triangle: self.width,
+            select_pdf: 0.0,
+            alias_prob: 0.0,
+            alias: self.height,
+        };
+        let rows = self.row_cdf.iter().map(|&c| Emitter {
+            triangle: c.to_bits(),
+            ..Default::default()
+        });
+        let texels = self.texels.iter().zip(&self.texel_cdf).map(|(t, &c)| Emitter {
+            triangle: t.x.to_bits(),
+            select_pdf: t.y,
+            alias_prob: t.z,
+            alias: c.to_bits(),
+        });
+        std::iter::once(header).chain(rows).chain(texels).collect()
+    }
+}

@@ -1,0 +1,297 @@
+//! The material model, twin of glsl/bsdf.glsl: a linear blend of a Lambertian lobe, a GGX
+//! conductor and a GGX (or smooth) dielectric. Directions point away from the surface.
+
+use glam::{Vec3, Vec4};
+use std::f32::consts::PI;
+
+use crate::gpu_types::Material;
+use crate::shading::sampling::{build_onb, pdf_cosine_hemisphere, sample_cosine_hemisphere, sample_ggx_vndf, to_local, to_world, INV_PI};
+
+/// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes
+/// are ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
+pub const DELTA_ALPHA: f32 = 1e-3;
+
+/// Relative IORs this close to 1 (2⁻¹⁶) are index-matched: the interface neither reflects nor
+/// bends light, and the dielectric lobe is an exact pass-through whatever the roughness. Closer
+/// to 1 the generalized half-vector wi η + wo, of length about |η − 1|, is lost in rounding.
+pub const INDEX_MATCHED_TOLERANCE: f32 = 1.0 / 65536.0;
+
+/// Twin of GLSL `index_matched`: whether relative IOR `eta` is within rounding of 1.
+pub fn index_matched(eta: f32) -> bool {
+    (eta - 1.0).abs() <= INDEX_MATCHED_TOLERANCE
+}
+
+pub const LOBE_NONE: u32 = 0;
+pub const LOBE_DIFFUSE: u32 = 1;
+pub const LOBE_CONDUCTOR: u32 = 2;
+pub const LOBE_DIELECTRIC: u32 = 4;
+pub const LOBE_DELTA: u32 = 8;
+pub const LOBE_TRANSMISSION: u32 = 16;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    pub weight: Vec3,
+    pub pdf: f32,
+    pub lobe: u32,
+}
+
+impl BsdfSample {
+    const FAILED: BsdfSample = BsdfSample {
+        wi: Vec3::ZERO,
+        weight: Vec3::ZERO,
+        pdf: 0.0,
+        lobe: LOBE_NONE,
+    };
+}
+
+pub fn ggx_alpha(roughness: f32) -> f32 {
+    roughness * roughness
+}
+
+/// sin^2 comes from x^2 + y^2 rather than 1 - z^2: near the lobe peak of a narrow GGX the
+/// latter cancels catastrophically in f32.
+pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let d = (h.x * h.x + h.y * h.y) + h.z * h.z * a2;
+    a2 / (PI * d * d)
+}
+
+pub fn smith_lambda(w: Vec3, alpha: f32) -> f32 {
+    let c2 = w.z * w.z;
+    if c2 <= 0.0 {
+        return 0.0;
+    }
+    let t2 = (w.x * w.x + w.y * w.y) / c2;
+    0.5 * (-1.0 + (1.0 + alpha * alpha * t2).sqrt())
+}
+
+pub fn smith_g1(w: Vec3, alpha: f32) -> f32 {
+    1.0 / (1.0 + smith_lambda(w, alpha))
+}
+
+pub fn smith_g2(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
+    1.0 / (1.0 + smith_lambda(wo, alpha) + smith_lambda(wi, alpha))
+}
+
+pub fn ggx_vndf_pdf(wo: Vec3, h: Vec3, alpha: f32) -> f32 {
+    smith_g1(wo, alpha) * wo.dot(h).max(0.0) * ggx_d(h, alpha) / wo.z.abs()
+}
+
+pub fn fresnel_schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
+    let m = (1.0 - cos_theta).clamp(0.0, 1.0);
+    let m5 = (m * m) * (m * m) * m;
+    f0 + (Vec3::ONE - f0) * m5
+}
+
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let (eta, cos_i) = if cos_i < 0.0 { (1.0 / eta, -cos_i) } else { (eta, cos_i) };
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_par * r_par + r_perp * r_perp)
+}
+
+/// Refraction of w about m; `None` on total internal reflection, else (direction, etap used).
+pub fn refract_dir(w: Vec3, m: Vec3, eta: f32) -> Option<(Vec3, f32)> {
+    let mut cos_i = m.dot(w);
+    let (mut eta, mut m) = (eta, m);
+    if cos_i < 0.0 {
+        eta = 1.0 / eta;
+        cos_i = -cos_i;
+        m = -m;
+    }
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((-w / eta + (cos_i / eta - cos_t) * m, eta))
+}
+
+pub fn lobe_weights(m: &Material) -> (f32, f32, f32) {
+    let t = m.transmission.clamp(0.0, 1.0);
+    let k = m.metallic.clamp(0.0, 1.0);
+    ((1.0 - t) * (1.0 - k), (1.0 - t) * k, t)
+}
+
+/// Rough dielectric (f * |cos_i|, pdf) in the local frame; +z is the outside.
+pub fn dielectric_eval_pdf(wo: Vec3, wi: Vec3, alpha: f32, eta: f32) -> (f32, f32) {
+    let (cos_o, cos_i) = (wo.z, wi.z);
+    if cos_o == 0.0 || cos_i == 0.0 {
+        return (0.0, 0.0);
+    }
+    let reflect = cos_o * cos_i > 0.0;
+    let etap = if reflect {
+        1.0
+    } else if cos_o > 0.0 {
+        eta
+    } else {
+        1.0 / eta
+    };
+    let wm = wi * etap + wo;
+    if wm.dot(wm) == 0.0 {
+        return (0.0, 0.0);
+    }
+    let mut wm = wm.normalize();
+    if wm.z < 0.0 {
+        wm = -wm;
+    }
+    if wm.dot(wi) * cos_i < 0.0 || wm.dot(wo) * cos_o < 0.0 {
+        return (0.0, 0.0);
+    }
+    let fr = fresnel_dielectric(wo.dot(wm), eta);
+    let d = ggx_d(wm, alpha);
+    let g = smith_g2(wo, wi, alpha);
+    let wo_up = wo * cos_o.signum();
+    let vis = smith_g1(wo_up, alpha) * wo.dot(wm).abs() * d / cos_o.abs();
+    if reflect {
+        (d * g * fr / (4.0 * cos_o.abs()), vis / (4.0 * wo.dot(wm).abs()) * fr)
+    } else {
+        let denom = wi.dot(wm) + wo.dot(wm) / etap;
+        let denom = denom * denom;
+        if !(denom > 0.0) {
+            return (0.0, 0.0);
+        }
+        let f_cos = d * (1.0 - fr) * g * (wi.dot(wm) * wo.dot(wm) / (cos_o * denom)).abs() / (etap * etap);
+        (f_cos, vis * wi.dot(wm).abs() / denom * (1.0 - fr))
+    }
+}
+
+/// Sum over the non-delta lobes of (f * |cos_i|, pdf) in the local frame.
+pub fn bsdf_eval_pdf_local(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+    let (w_d, w_c, w_t) = lobe_weights(m);
+    let alpha = ggx_alpha(m.roughness);
+    let base = Vec3::from(m.base_color);
+    let mut f_cos = Vec3::ZERO;
+    let mut pdf = 0.0;
+    let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
+    let flip = Vec3::new(1.0, 1.0, side);
+    let (wo_s, wi_s) = (wo * flip, wi * flip);
+    let same_side = wo_s.z > 0.0 && wi_s.z > 0.0;
+    if w_d > 0.0 && same_side {
+        f_cos += w_d * base * INV_PI * wi_s.z;
+        pdf += w_d * pdf_cosine_hemisphere(wi_s.z);
+    }
+    if w_c > 0.0 && same_side && alpha >= DELTA_ALPHA {
+        let h = (wo_s + wi_s).normalize();
+        let f = fresnel_schlick(base, wo_s.dot(h));
+        f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
+        pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
+    }
+    if w_t > 0.0 && alpha >= DELTA_ALPHA && !index_matched(m.ior) {
+        let (fc, p) = dielectric_eval_pdf(wo, wi, alpha, m.ior);
+        f_cos += w_t * base * fc;
+        pdf += w_t * p;
+    }
+    (f_cos, pdf)
+}
+
+/// (f * |cos_i| of the non-delta lobes, solid-angle pdf of `bsdf_sample` producing wi).
+pub fn bsdf_eval_pdf(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+    let (t, b) = build_onb(n);
+    bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n))
+}
+
+/// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
+pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
+    let (t, b) = build_onb(n);
+    let wo = to_local(wo_world, t, b, n);
+    if wo.z == 0.0 {
+        return BsdfSample::FAILED;
+    }
+    let (w_d, w_c, w_t) = lobe_weights(m);
+    let alpha = ggx_alpha(m.roughness);
+    let base = Vec3::from(m.base_color);
+    let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
+    let flip = Vec3::new(1.0, 1.0, side);
+    let wo_s = wo * flip;
+    let mirrored = Vec3::new(-wo.x, -wo.y, wo.z);
+    let (wi, lobe) = if u.z < w_d {
+        (sample_cosine_hemisphere(u.truncate().truncate()) * flip, LOBE_DIFFUSE)
+    } else if u.z < w_d + w_c {
+        if alpha < DELTA_ALPHA {
+            return BsdfSample {
+                wi: to_world(mirrored, t, b, n),
+                weight: fresnel_schlick(base, wo_s.z),
+                pdf: w_c,
+                lobe: LOBE_CONDUCTOR | LOBE_DELTA,
+            };
+        }
+        let h = sample_ggx_vndf(wo_s, alpha, u.truncate().truncate());
+        let wi_s = reflect(-wo_s, h);
+        // Below the surface the conductor has no density; another lobe's pdf there must not
+        // turn this sample into a success.
+        if wi_s.z <= 0.0 {
+            return BsdfSample::FAILED;
+        }
+        (wi_s * flip, LOBE_CONDUCTOR)
+    } else {
+        if w_t <= 0.0 {
+            return BsdfSample::FAILED;
+        }
+        if index_matched(m.ior) {
+            return BsdfSample {
+                wi: -wo_world,
+                weight: base,
+                pdf: w_t,
+                lobe: LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION,
+            };
+        }
+        if alpha < DELTA_ALPHA {
+            let fr = fresnel_dielectric(wo.z, m.ior);
+            if u.w < fr {
+                return BsdfSample {
+                    wi: to_world(mirrored, t, b, n),
+                    weight: base,
+                    pdf: w_t * fr,
+                    lobe: LOBE_DIELECTRIC | LOBE_DELTA,
+                };
+            }
+            let Some((wt, etap)) = refract_dir(wo, Vec3::Z, m.ior) else {
+                return BsdfSample::FAILED;
+            };
+            return BsdfSample {
+                wi: to_world(wt, t, b, n),
+                weight: base / (etap * etap),
+                pdf: w_t * (1.0 - fr),
+                lobe: LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION,
+            };
+        }
+        let wm = sample_ggx_vndf(wo * side, alpha, u.truncate().truncate());
+        let fr = fresnel_dielectric(wo.dot(wm), m.ior);
+        // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
+        // evaluated for the other event.
+        if u.w < fr {
+            let wi = reflect(-wo, wm);
+            if wi.z * wo.z <= 0.0 {
+                return BsdfSample::FAILED;
+            }
+            (wi, LOBE_DIELECTRIC)
+        } else {
+            match refract_dir(wo, wm, m.ior) {
+                Some((wt, _)) if wt.z * wo.z < 0.0 => (wt, LOBE_DIELECTRIC | LOBE_TRANSMISSION),
+                _ => return BsdfSample::FAILED,
+            }
+        }
+    };
+    let (f_cos, pdf) = bsdf_eval_pdf_local(m, wo, wi);
+    if !(pdf > 0.0) {
+        return BsdfSample::FAILED;
+    }
+    BsdfSample {
+        wi: to_world(wi, t, b, n),
+        weight: f_cos / pdf,
+        pdf,
+        lobe,
+    }
+}
+
+/// GLSL's reflect(I, N) = I - 2 dot(N, I) N.
+pub fn reflect(i: Vec3, n: Vec3) -> Vec3 {
+    i - 2.0 * n.dot(i) * n
+}

@@ -1,0 +1,232 @@
+//! Next-event estimation: the alias table over emitter power and the twin of glsl/lights.glsl.
+//! Punctual lights (KHR_lights_punctual) share the alias table with emissive triangles; a sample
+//! of one is a delta: its `pdf` is the discrete probability of choosing the light, its
+//! `radiance` the irradiance-like I·falloff/d² (or E), and MIS gives it weight 1.
+
+use glam::{Vec2, Vec3};
+
+use crate::gpu_types::{Emitter, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use crate::scene::{PunctualKind, PunctualLight, Scene};
+use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample {
+    pub dir: Vec3,
+    pub dist: f32,
+    pub radiance: Vec3,
+    pub pdf: f32,
+    /// The emitter triangle sampled, NO_EMITTER for the environment, PUNCTUAL_LIGHT_BIT | k for
+    /// punctual light k.
+    pub triangle: u32,
+}
+
+/// Whether a light or vertex id names a punctual light (twin of GLSL `is_punctual_light`).
+pub fn is_punctual_light(id: u32) -> bool {
+    id != NO_EMITTER && id & PUNCTUAL_LIGHT_BIT != 0
+}
+
+/// The spot cone's smooth falloff for light leaving along `dir_out` (unit): the square of
+/// clamp((cos θ - cos outer) / (cos inner - cos outer), 0, 1), KHR_lights_punctual's recommended
+/// formula; 1 for point and directional lights. Twin of GLSL `spot_falloff`.
+pub fn spot_falloff(light: &PunctualLight, dir_out: Vec3) -> f32 {
+    if light.kind != PunctualKind::Spot {
+        return 1.0;
+    }
+    let scale = 1.0 / (light.cos_inner - light.cos_outer).max(1e-3);
+    let t = ((light.direction.dot(dir_out) - light.cos_outer) * scale).clamp(0.0, 1.0);
+    t * t
+}
+
+/// What punctual light `light` sends to point `p`: the unit direction from p towards it, the
+/// distance (infinite for a directional light) and I·falloff/d² (point, spot) or E
+/// (directional), the factor that multiplies f_s |cos| at p. Twin of GLSL `punctual_arrival`.
+pub fn punctual_arrival(light: &PunctualLight, p: Vec3) -> (Vec3, f32, Vec3) {
+    if light.kind == PunctualKind::Directional {
+        return (-light.direction, f32::INFINITY, light.intensity);
+    }
+    let to_light = light.position - p;
+    let d2 = to_light.dot(to_light);
+    if !(d2 > 0.0) {
+        return (Vec3::Z, 0.0, Vec3::ZERO);
+    }
+    let dist = d2.sqrt();
+    let dir = to_light / dist;
+    (dir, dist, light.intensity * (spot_falloff(light, -dir) / d2))
+}
+
+/// Whether anything blocks the way from surface point `x` (normal `n`, on triangle index `tri`)
+/// to a punctual light along the unit `dir` at distance `dist` (infinite: a directional light);
+/// only x is offset, the light being a point in the air. Twin of GLSL `punctual_occluded` (glsl/punctual.glsl).
+pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, tri: u32, dir: Vec3, dist: f32) -> bool {
+    use crate::scene::bvh::{trace_occluded, SEGMENT_EPSILON};
+    let origin = crate::shading::ray_offset::offset_ray_origin(x, if dir.dot(n) > 0.0 { n } else { -n }, &scene.triangles[tri as usize]);
+    if dist.is_infinite() {
+        return trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
+    }
+    trace_occluded(
+        &scene.nodes,
+        &scene.triangles,
+        origin,
+        x + dir * dist - origin,
+        1.0 - SEGMENT_EPSILON,
+    )
+}
+
+/// The probability that NEE chooses punctual light `k` (a discrete probability, not a density).
+/// Twin of GLSL `punctual_pdf`.
+pub fn punctual_pdf(scene: &Scene, k: u32) -> f32 {
+    (1.0 - scene.env_select_prob) * scene.light_select_pdf(k as usize)
+}
+
+/// Vose's alias table over `weights` (all finite, non-negative, positive sum).
+pub fn build_alias_table(triangles: &[u32], weights: &[f32]) -> Vec<Emitter> {
+    let n = weights.len();
+    let total: f64 = weights.iter().map(|&w| w as f64).sum();
+    let mut table: Vec<Emitter> = triangles
+        .iter()
+        .zip(weights)
+        .map(|(&t, &w)| Emitter {
+            triangle: t,
+            select_pdf: (w as f64 / total) as f32,
+            alias_prob: 1.0,
+            alias: 0,
+        })
+        .collect();
+    let mut scaled: Vec<f64> = weights.iter().map(|&w| w as f64 * n as f64 / total).collect();
+    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+    while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+        table[s].alias_prob = scaled[s] as f32;
+        table[s].alias = l as u32;
+        scaled[l] -= 1.0 - scaled[s];
+        if scaled[l] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    for i in small.into_iter().chain(large) {
+        table[i].alias_prob = 1.0;
+        table[i].alias = i as u32;
+    }
+    table
+}
+
+/// Emitted radiance of triangle index `triangle` at barycentrics `bary` towards `to_viewer`
+/// (front face only unless double-sided), its emissive texture applied.
+pub fn emitted_radiance(scene: &Scene, triangle: u32, bary: glam::Vec2, to_viewer: Vec3) -> Vec3 {
+    let tri = &scene.triangles[triangle as usize];
+    let m = &scene.material_at(triangle, bary);
+    let facing = tri.normal_area2().dot(to_viewer);
+    let lit = facing > 0.0 || (m.is_double_sided() && facing < 0.0);
+    if lit {
+        Vec3::from(m.emission)
+    } else {
+        Vec3::ZERO
+    }
+}
+
+pub fn alias_select(emitters: &[Emitter], u: f32, count: u32) -> u32 {
+    let scaled = u * count as f32;
+    let i = (scaled as u32).min(count - 1);
+    let coin = scaled - i as f32;
+    if coin < emitters[i as usize].alias_prob {
+        i
+    } else {
+        emitters[i as usize].alias
+    }
+}
+
+pub fn emitter_pdf(scene: &Scene, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
+    let tri = &scene.triangles[tri_index as usize];
+    if tri.emitter == NO_EMITTER {
+        return 0.0;
+    }
+    let ng = tri.normal_area2();
+    let area2 = ng.length();
+    let cos_l = ng.dot(dir).abs() / area2;
+    if cos_l <= 0.0 {
+        return 0.0;
+    }
+    let p_area = (1.0 - scene.env_select_prob) * scene.emitters[tri.emitter as usize].select_pdf * 2.0 / area2;
+    p_area * dist * dist / cos_l
+}
+
+/// Solid-angle pdf that NEE samples the environment in direction `dir` (unit): uniform over the
+/// sphere for a constant environment, the map's luminance density for a map. Twin of GLSL
+/// `environment_pdf`.
+pub fn environment_pdf(scene: &Scene, dir: Vec3) -> f32 {
+    scene.env_select_prob
+        * match &scene.environment_map {
+            Some(map) => map.pdf(dir),
+            None => UNIFORM_SPHERE_PDF,
+        }
+}
+
+/// Environment radiance arriving from direction `dir` (unit). Twin of GLSL
+/// `environment_radiance`.
+pub fn environment_radiance(scene: &Scene, dir: Vec3) -> Vec3 {
+    match &scene.environment_map {
+        Some(map) => map.radiance(dir),
+        None => scene.environment,
+    }
+}
+
+/// u.x selects the light, u.yz the point or direction.
+pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
+    let none = LightSample {
+        dir: Vec3::Z,
+        dist: 0.0,
+        radiance: Vec3::ZERO,
+        pdf: 0.0,
+        triangle: NO_EMITTER,
+    };
+    let p_env = scene.env_select_prob;
+    if u.x < p_env {
+        let dir = match &scene.environment_map {
+            Some(map) => map.sample_environment(Vec2::new(u.y, u.z)),
+            None => sample_uniform_sphere(Vec2::new(u.y, u.z)),
+        };
+        return LightSample {
+            dir,
+            dist: f32::INFINITY,
+            radiance: environment_radiance(scene, dir),
+            pdf: environment_pdf(scene, dir),
+            triangle: NO_EMITTER,
+        };
+    }
+    if scene.emitters.is_empty() {
+        return none;
+    }
+    let u_select = (u.x - p_env) / (1.0 - p_env);
+    let e = scene.emitters[alias_select(&scene.emitters, u_select.min(0.99999994), scene.emitters.len() as u32) as usize];
+    if is_punctual_light(e.triangle) {
+        let k = e.triangle & !PUNCTUAL_LIGHT_BIT;
+        let (dir, dist, radiance) = punctual_arrival(&scene.lights[k as usize], p);
+        if !(dist > 0.0) {
+            return none;
+        }
+        return LightSample {
+            dir,
+            dist,
+            radiance,
+            pdf: punctual_pdf(scene, k),
+            triangle: e.triangle,
+        };
+    }
+    let tri = &scene.triangles[e.triangle as usize];
+    let b = sample_triangle(Vec2::new(u.y, u.z));
+    let q = Vec3::from(tri.v0) + b.x * Vec3::from(tri.e1) + b.y * Vec3::from(tri.e2);
+    let to_light = q - p;
+    let d2 = to_light.dot(to_light);
+    if d2 <= 0.0 {
+        return none;
+    }
+    let dist = d2.sqrt();
+    let dir = to_light / dist;
+    LightSample {
+        dir,
+        dist,
+        radiance: emitted_radiance(scene, e.triangle, b, -dir),
+        pdf: emitter_pdf(scene, e.triangle, dir, dist),
+        triangle: e.triangle,
+    }
+}

@@ -1,0 +1,214 @@
+//! GLSL against Rust for resampling: `mis_weight` of glsl/gris.glsl (generalized balance
+//! heuristic and pairwise MIS) against `gris::mis_weight`, and the streaming resampler of
+//! glsl/reservoir.glsl (`Resampler`, `resampler_begin`, `resampler_add`/`resampler_offer`,
+//! `resampler_finish`) against its twins in src/shading/gris.rs, on recorded inputs: tables of
+//! confidence weights and p̂_{<-l}(y_i) with failed shifts (zeros) and six decades of range, and
+//! offered candidates with zero weights and lost choices, as the reuse passes see them.
+
+use glam::{Vec3, Vec4};
+use restir_pt::shading::gris::{mis_weight, resampler_begin, resampler_finish, resampler_offer, Domains, Input, Mis};
+
+use crate::common::{close, gpu, run_oracle_with_defines, TestRng};
+
+/// Inputs per resampling in the kernels (glsl/gris.glsl MAX_INPUTS).
+const MAX_INPUTS: usize = 9;
+const CASES: usize = 4096;
+
+/// One candidate offered to the resampler.
+#[derive(Clone, Copy, Default)]
+struct Offer {
+    contribution: Vec3,
+    target: f32,
+    weight: f32,
+    u: f32,
+    /// Recording the candidate fails if it is chosen (record_chosen's loss).
+    lost: bool,
+}
+
+/// One resampling: n inputs, their confidences c_l, the row p̂_{<-l}(y_i) of every input i's
+/// shifted sample, and the candidates the inputs offer.
+struct Case {
+    n: usize,
+    confidences: [f32; MAX_INPUTS],
+    targets: [[f32; MAX_INPUTS]; MAX_INPUTS],
+    offers: [Offer; MAX_INPUTS],
+}
+
+/// 10^e for e uniform in [-3, 3].
+fn log_uniform(r: &mut TestRng) -> f32 {
+    10f32.powf(6.0 * r.uniform() - 3.0)
+}
+
+fn recorded_cases(seed: u64) -> Vec<Case> {
+    let mut r = TestRng(seed);
+    (0..CASES)
+        .map(|_| {
+            let n = 1 + (r.next_u64() % MAX_INPUTS as u64) as usize;
+            let mut case = Case {
+                n,
+                confidences: [0.0; MAX_INPUTS],
+                targets: [[0.0; MAX_INPUTS]; MAX_INPUTS],
+                offers: [Offer::default(); MAX_INPUTS],
+            };
+            for l in 0..n {
+                // Reservoir confidences are whole candidate counts, capped at 20.
+                case.confidences[l] = (1 + r.next_u64() % 20) as f32;
+            }
+            // A quarter of the rows come from a sample no other domain reaches.
+            for row in case.targets.iter_mut().take(n) {
+                let isolated = r.uniform() < 0.25;
+                for (l, t) in row.iter_mut().enumerate().take(n) {
+                    let failed = (l != 0 && isolated) || r.uniform() < 0.25;
+                    *t = if failed { 0.0 } else { log_uniform(&mut r) };
+                }
+            }
+            for offer in case.offers.iter_mut().take(n) {
+                let target = log_uniform(&mut r);
+                let colour = Vec3::new(r.uniform(), r.uniform(), r.uniform()) + 0.01;
+                *offer = Offer {
+                    contribution: colour * target / restir_pt::metrics::luminance(colour),
+                    target,
+                    weight: if r.uniform() < 0.2 { 0.0 } else { log_uniform(&mut r) },
+                    u: r.uniform(),
+                    lost: r.uniform() < 0.05,
+                };
+            }
+            case
+        })
+        .collect()
+}
+
+/// The recorded table as GRIS domains: sample i is input i's shifted sample y_i.
+struct Recorded<'a>(&'a Case);
+
+impl Domains<usize> for Recorded<'_> {
+    fn shift(&self, _: usize, x: usize) -> Option<(usize, f64)> {
+        Some((x, 1.0))
+    }
+    fn target_from(&self, l: usize, y: usize) -> f64 {
+        self.0.targets[y][l] as f64
+    }
+    fn target(&self, y: usize) -> f64 {
+        self.0.targets[y][0] as f64
+    }
+}
+
+/// The GLSL kernel's outputs for every case: 4 vec4 each.
+fn run_glsl(cases: &[Case], mis: Mis) -> Vec<Vec4> {
+    let ctx = gpu();
+    let counts: Vec<u32> = cases.iter().map(|c| c.n as u32).collect();
+    let confidences: Vec<f32> = cases.iter().flat_map(|c| c.confidences).collect();
+    let targets: Vec<f32> = cases.iter().flat_map(|c| c.targets.into_iter().flatten()).collect();
+    let offers: Vec<Vec4> = cases
+        .iter()
+        .flat_map(|c| c.offers)
+        .flat_map(|o| [o.contribution.extend(o.target), Vec4::new(o.weight, o.u, o.lost as u32 as f32, 0.0)])
+        .collect();
+    let mode = if mis == Mis::Pairwise { "1" } else { "0" };
+    let out = run_oracle_with_defines(
+        &ctx,
+        "oracle/gris_oracle.comp",
+        &[("MIS_MODE", mode)],
+        &[],
+        &[
+            bytemuck::cast_slice(&counts),
+            bytemuck::cast_slice(&confidences),
+            bytemuck::cast_slice(&targets),
+            bytemuck::cast_slice(&offers),
+        ],
+        cases.len() * 16,
+        cases.len() as u32,
+    );
+    crate::common::assert_clean(&ctx);
+    out
+}
+
+/// GLSL mis_weight against gris::mis_weight for every input of every case, within 1e-5 (the
+/// weights lie in [0, 1]; single against double precision over at most 9 terms).
+fn check_mis_weight(mis: Mis) {
+    let cases = recorded_cases(2024 + mis as u64);
+    let out = run_glsl(&cases, mis);
+    let mut positive = 0;
+    for (k, case) in cases.iter().enumerate() {
+        let g = &out[4 * k..4 * k + 4];
+        let gpu_weights = [g[0].x, g[0].y, g[0].z, g[0].w, g[1].x, g[1].y, g[1].z, g[1].w, g[2].x];
+        let inputs: Vec<Input<usize>> = (0..case.n)
+            .map(|i| Input {
+                sample: i,
+                contribution_weight: 1.0,
+                confidence: case.confidences[i] as f64,
+            })
+            .collect();
+        for (i, &gpu_weight) in gpu_weights.iter().enumerate().take(case.n) {
+            let rust = mis_weight(&Recorded(case), &inputs, mis, i, i) as f32;
+            assert!(
+                close(gpu_weight, rust, 1e-5),
+                "case {k} (n = {}) input {i} {mis:?}: GLSL mis_weight {gpu_weight} vs Rust gris::mis_weight {rust}",
+                case.n
+            );
+            positive += (rust > 0.0) as usize;
+        }
+    }
+    eprintln!("{mis:?}: {positive} positive weights compared over {CASES} cases");
+    assert!(positive > CASES, "{mis:?}: only {positive} positive weights");
+}
+
+#[test]
+fn gris_mis_weight_generalized_balance_glsl_matches_rust() {
+    check_mis_weight(Mis::GeneralizedBalance);
+}
+
+#[test]
+fn gris_mis_weight_pairwise_glsl_matches_rust() {
+    check_mis_weight(Mis::Pairwise);
+}
+
+/// GLSL Resampler (resampler_begin, resampler_add, resampler_finish) against the Rust twins
+/// (resampler_begin, resampler_offer, resampler_finish): the same chosen input, except where
+/// u sum w lies within 1e-5 of w (counted, at most 0.1%), W and `expected` within 1e-5
+/// relative, M exactly.
+#[test]
+fn gris_resampler_glsl_matches_rust() {
+    let cases = recorded_cases(77);
+    let out = run_glsl(&cases, Mis::GeneralizedBalance);
+    let (mut ties, mut chosen, mut lost) = (0, 0, 0);
+    for (k, case) in cases.iter().enumerate() {
+        let g = &out[4 * k..4 * k + 4];
+        let mut s = resampler_begin::<usize>();
+        let mut tie = false;
+        for (i, o) in case.offers.iter().enumerate().take(case.n) {
+            s.confidence += case.confidences[i];
+            // The recorded weights are finite: zero stands for a failed shift.
+            if o.weight <= 0.0 {
+                continue;
+            }
+            let sum = s.weight_sum + o.weight;
+            tie |= (o.u * sum - o.weight).abs() <= 1e-5 * o.weight;
+            if resampler_offer(&mut s, o.contribution, o.target, o.weight, o.u) {
+                s.chosen = Some(i);
+            }
+        }
+        if let Some(i) = s.chosen {
+            s.chosen_lost = case.offers[i].lost;
+        }
+        let (sample, w, m) = resampler_finish(&s);
+        let gpu_chosen = (g[2].y >= 0.0).then_some(g[2].y as usize);
+        if gpu_chosen != sample {
+            assert!(tie, "case {k}: GLSL chose {gpu_chosen:?}, Rust {sample:?}");
+            ties += 1;
+            continue;
+        }
+        chosen += sample.is_some() as usize;
+        lost += s.chosen_lost as usize;
+        let rel = |a: f32, b: f32| (a - b).abs() <= 1e-5 * a.abs().max(b.abs());
+        assert!(rel(g[2].z, w) || g[2].z == w, "case {k}: W GLSL {} vs Rust {w}", g[2].z);
+        assert_eq!(g[2].w, m, "case {k}: M");
+        for c in 0..3 {
+            let (a, b) = (g[3][c], s.expected[c]);
+            assert!(rel(a, b) || a == b, "case {k}: expected GLSL {} vs Rust {}", g[3], s.expected);
+        }
+    }
+    eprintln!("resampler: {chosen} choices compared ({lost} lost), {ties} ties excluded of {CASES}");
+    assert!(ties * 1000 <= CASES, "{ties} ties");
+    assert!(chosen > CASES / 2 && lost > 0, "{chosen} choices, {lost} lost");
+}
