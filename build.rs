@@ -24,11 +24,11 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<(String, PathBuf)>) {
 /// `git rev-parse --short HEAD` of the crate, or "unknown" without git or outside a repository;
 /// rebuilds when HEAD moves.
 fn embed_commit() {
-    let dir = env!("CARGO_MANIFEST_DIR");
+    let dir = manifest_dir();
     let git = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)
-            .current_dir(dir)
+            .current_dir(&dir)
             .output()
             .ok()
             .filter(|o| o.status.success())
@@ -41,7 +41,7 @@ fn embed_commit() {
     let head_ref = git(&["symbolic-ref", "-q", "HEAD"]);
     for name in ["HEAD", "packed-refs"].into_iter().map(String::from).chain(head_ref) {
         if let Some(path) = git(&["rev-parse", "--git-path", &name]) {
-            let path = Path::new(dir).join(path);
+            let path = Path::new(&dir).join(path);
             if path.exists() {
                 println!("cargo:rerun-if-changed={}", path.display());
             }
@@ -49,9 +49,16 @@ fn embed_commit() {
     }
 }
 
+/// The crate's folder, read when the script runs: `env!` would bake in the folder the script was
+/// compiled in, and a build script reused from another checkout (a copied target/) would then
+/// embed that checkout's kernels.
+fn manifest_dir() -> String {
+    std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR")
+}
+
 fn main() {
     embed_commit();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+    let root = Path::new(&manifest_dir()).join("glsl");
     println!("cargo:rerun-if-changed=glsl");
     let mut files = Vec::new();
     collect(&root, &root, &mut files);

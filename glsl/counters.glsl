@@ -8,6 +8,8 @@
 #ifndef COUNTERS_GLSL
 #define COUNTERS_GLSL
 
+#include "shader_interface.glsl"
+
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
@@ -22,7 +24,6 @@ const uint COUNTER_PATH_STEPS = 3u;
 const uint COUNTER_NODE_ITERATIONS = 4u;
 const uint COUNTER_TRIANGLE_ITERATIONS = 5u;
 const uint COUNTER_STEP_ITERATIONS = 6u;
-const uint COUNTER_COUNT = 7u;
 
 #if TRAVERSAL_COUNTERS
 uint profile_counts[COUNTER_COUNT] = uint[COUNTER_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u);

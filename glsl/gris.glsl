@@ -1,20 +1,16 @@
 // Resampling MIS weights of generalized RIS (docs/restir.md): the generalized balance heuristic
 // m_i(y) = c_i p̂_{<-i}(y) / sum_j c_j p̂_{<-j}(y) and defensive pairwise MIS, over the inputs of
 // one resampling. Twin: src/shading/gris.rs (mis_weight); MIS_MODE selects the weight at compile time.
-// Needs nothing but the loop budget, so that an oracle kernel can include it alone.
+// Needs nothing but the loop budget and the shader interface's limits, so that an oracle kernel can include it alone.
 #ifndef GRIS_GLSL
 #define GRIS_GLSL
 
+#include "shader_interface.glsl"
 #include "loop_budget.glsl"
 
-#define MIS_GBH 0
-#define MIS_PAIRWISE 1
 #ifndef MIS_MODE
 #define MIS_MODE MIS_GBH
 #endif
-
-// Canonical input plus up to 8 neighbours.
-const uint MAX_INPUTS = 9u;
 
 // The confidence weights c_l of the current resampling's inputs (0: the canonical one), and
 // p̂_{<-l}(y) for the sample y whose weight is wanted: [0] p̂(y) of the canonical domain, [l]

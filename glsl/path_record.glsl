@@ -2,7 +2,8 @@
 #ifndef PATH_RECORD_GLSL
 #define PATH_RECORD_GLSL
 
-const uint MAX_PATH_LENGTH = 7u;
+#include "shader_interface.glsl"
+
 const uint LOBE_BITS = 5u;
 const uint INFO_LENGTH_MASK = 15u;
 const uint INFO_RC_SHIFT = 4u;

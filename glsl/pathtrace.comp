@@ -3,14 +3,16 @@
 // starting the next path as soon as one ends (see path_tracer.glsl).
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+#include "shader_interface.glsl"
+
+layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
 #include "scene_bindings.glsl"
 #include "path_tracer.glsl"
 
-layout(std430, set = 0, binding = 5) buffer Accum { vec4 accum[]; };       // rgb: sum of L, w: count
-layout(std430, set = 0, binding = 6) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of L^2
-layout(std430, set = 0, binding = 7) buffer Status {
+layout(std430, set = 0, binding = PATHTRACE_BINDING_ACCUM) buffer Accum { vec4 accum[]; };       // rgb: sum of L, w: count
+layout(std430, set = 0, binding = PATHTRACE_BINDING_ACCUM_SQ) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of L^2
+layout(std430, set = 0, binding = PATHTRACE_BINDING_STATUS) buffer Status {
     uint max_loop_iterations;
     uint loop_budget_cut_groups;
     uint nonfinite_paths;           // paths whose radiance or throughput is NaN or infinite

@@ -62,6 +62,11 @@ Reservoir reservoir_join(ReservoirHead h, ReservoirTail t) {
     return Reservoir(p, t.weight, t.confidence);
 }
 
+// Resampling weights must be finite: a non-finite one is counted and dropped, never offered.
+bool is_finite(float x) {
+    return !isnan(x) && !isinf(x);
+}
+
 // Streaming weighted selection: after add() of candidates with weights w_i, `chosen` is candidate
 // i with probability w_i / sum w and W = sum w / p̂(chosen).
 // `expected` is the expectation of f(Y) W_Y over the choice, sum w_i f(y_i) / p̂(y_i): the

@@ -1,4 +1,5 @@
-// The bindings every ReSTIR PT kernel shares (set 0, after the scene's 0-4), with loads and
+// The bindings every ReSTIR PT kernel shares (set 0, after the scene's 0-4, numbered by
+// RestirBinding in src/shader_interface.rs, which also sets RESTIR_MAX_PASSES), with loads and
 // stores by slot. Twins: ReuseParams, Surface, ReservoirHead/Tail, RestirStats and RestirPass
 // in src/gpu_types.rs. Each pass reads its slots from the frame's pass table, picked by a push
 // constant, so that one descriptor set serves every pass: reservoir slots 0-2 rotate between
@@ -22,10 +23,7 @@ struct RestirPass {
     uint pass_seed;      // distinguishes the random choices of passes and rounds
 };
 
-// The most passes a frame runs: initial, temporal, 3 spatial rounds and shading.
-const uint RESTIR_MAX_PASSES = 6u;
-
-layout(std430, set = 0, binding = 5) readonly buffer ReuseParams {
+layout(std430, set = 0, binding = RESTIR_BINDING_REUSE_PARAMS) readonly buffer ReuseParams {
     vec4 prev_cam_position;  // the previous frame's camera, laid out like FrameParams' camera
     vec4 prev_cam_right;
     vec4 prev_cam_up;
@@ -56,18 +54,18 @@ struct Surface {
     float depth;     // distance from the camera
 };
 
-layout(std430, set = 0, binding = 6) buffer Surfaces0 { Surface surfaces0[]; };
-layout(std430, set = 0, binding = 7) buffer Surfaces1 { Surface surfaces1[]; };
-layout(std430, set = 0, binding = 8) buffer Heads0 { ReservoirHead heads0[]; };
-layout(std430, set = 0, binding = 9) buffer Tails0 { ReservoirTail tails0[]; };
-layout(std430, set = 0, binding = 10) buffer Heads1 { ReservoirHead heads1[]; };
-layout(std430, set = 0, binding = 11) buffer Tails1 { ReservoirTail tails1[]; };
-layout(std430, set = 0, binding = 12) buffer Heads2 { ReservoirHead heads2[]; };
-layout(std430, set = 0, binding = 13) buffer Tails2 { ReservoirTail tails2[]; };
-layout(std430, set = 0, binding = 14) buffer Direct { vec4 direct[]; };     // rgb: emission seen directly, w: frames averaged
-layout(std430, set = 0, binding = 15) buffer Accum { vec4 accum[]; };       // rgb: sum of frames, w: count
-layout(std430, set = 0, binding = 16) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of squares
-layout(std430, set = 0, binding = 17) buffer RestirStats {
+layout(std430, set = 0, binding = RESTIR_BINDING_SURFACES0) buffer Surfaces0 { Surface surfaces0[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_SURFACES1) buffer Surfaces1 { Surface surfaces1[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_HEADS0) buffer ReservoirHeads0 { ReservoirHead heads0[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_TAILS0) buffer ReservoirTails0 { ReservoirTail tails0[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_HEADS1) buffer ReservoirHeads1 { ReservoirHead heads1[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_TAILS1) buffer ReservoirTails1 { ReservoirTail tails1[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_HEADS2) buffer ReservoirHeads2 { ReservoirHead heads2[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_TAILS2) buffer ReservoirTails2 { ReservoirTail tails2[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_DIRECT) buffer Direct { vec4 direct[]; };     // rgb: emission seen directly, w: frames averaged
+layout(std430, set = 0, binding = RESTIR_BINDING_ACCUM) buffer Accum { vec4 accum[]; };       // rgb: sum of frames, w: count
+layout(std430, set = 0, binding = RESTIR_BINDING_ACCUM_SQ) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of squares
+layout(std430, set = 0, binding = RESTIR_BINDING_RESTIR_STATS) buffer RestirStats {
     uint max_loop_iterations;
     uint loop_budget_cut_groups;
     uint shifts_attempted;
@@ -79,7 +77,7 @@ layout(std430, set = 0, binding = 17) buffer RestirStats {
 };
 // rgb: the expectation of f(Y) W_Y over the last resampling's choice (see Resampler), written by
 // whichever pass last resampled the pixel.
-layout(std430, set = 0, binding = 18) buffer Expectation { vec4 expectation[]; };
+layout(std430, set = 0, binding = RESTIR_BINDING_EXPECTATION) buffer Expectation { vec4 expectation[]; };
 
 layout(push_constant) uniform PassIndex {
     uint pass_index;     // this dispatch's entry of `passes`
@@ -158,10 +156,6 @@ void report_pass_stats() {
         if (dropped > 0u) atomicAdd(candidates_dropped, dropped);
         if (pixels > 0u) atomicAdd(nonfinite_pixels, pixels);
     }
-}
-
-bool is_finite(float x) {
-    return !isnan(x) && !isinf(x);
 }
 
 #endif

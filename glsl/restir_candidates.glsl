@@ -4,11 +4,13 @@
 // (end_mis_weight in shift.glsl): the two weighted integrands sum to the path's, and each is a
 // function of the path that the shifts evaluate anew (the end type travels in the record). The
 // paths are built with the steps trace_vertices() in shift.glsl regenerates them with
-// (nee_vertex, bsdf_vertex).
+// (nee_vertex, bsdf_vertex). Expects the scene bindings and the pass counters
+// local_nonfinite_weights and local_candidates_dropped (restir_bindings.glsl; an oracle kernel
+// declares its own). Twin: src/shading/candidates.rs.
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
 
-#include "restir_bindings.glsl"
+#include "reservoir.glsl"
 #include "shift.glsl"
 
 // A candidate of the path being traced, described against that path: its first `count`
@@ -82,7 +84,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         Vertex light;
         if (nee_vertex(x, seed, i, ls, light)) {
             float bsdf_pdf;
-            vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
+            vec3 f_cos = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir, bsdf_pdf);
             if (max_component(f_cos) > 0.0 && visible(x, light)) {
                 vec3 weight = f_cos / ls.pdf;
                 // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand (equal

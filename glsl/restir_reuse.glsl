@@ -11,9 +11,6 @@
 #include "gris.glsl"
 #include "shift.glsl"
 
-#define SHIFT_RECONNECTION 0
-#define SHIFT_REPLAY 1
-#define SHIFT_HYBRID 2
 #ifndef SHIFT_MODE
 #define SHIFT_MODE SHIFT_HYBRID
 #endif
@@ -89,23 +86,27 @@ ShiftParams reuse_shift_params() {
     return ShiftParams(roughness_threshold, distance_threshold);
 }
 
-// The selected shift of `record` into domain `to`: with `inverse` false the forward shift T_i of
-// input i's sample into the canonical domain; with `inverse` true T_l^{-1}, which carries a
-// sample of the canonical domain back into input l's domain `to` (the p̂_{<-l} terms of the MIS
-// weights). Within one domain the shift is the identity, which callers skip.
-ShiftResult shift_path(PathRecord record, Domain to, bool inverse) {
+// The selected shift of `record` into domain `to`, as an inverse shift. For the MIS weights'
+// p̂_{<-l}(y), T_l^{-1} carries a sample y of the canonical domain back into input l's domain
+// `to`. The forward shift T_i of input i's sample x_i into the canonical domain `to` is the
+// inverse of T_i^{-1}, the shift out of the canonical domain into domain i, evaluated at x_i:
+// inverse_* of x_i's record with the canonical domain's primary vertex. So every shift of a
+// resampling is this one call of inverse_*: a kernel inlines each call site whole, and a second
+// call site for the forward shifts (shift_*) made the temporal and spatial kernels' SPIR-V 45%
+// larger and their llvmpipe compile 2.5 times slower (docs/lab-notebook.md, "Compile time of
+// the reuse kernels"). Within one domain the shift is the identity, which callers skip.
+ShiftResult shift_path(PathRecord record, Domain to) {
     local_shifts_attempted += 1u;
     vec3 camera;
     Vertex v1;
     ShiftResult s = shift_failed();
     if (domain_primary(to, record, camera, v1)) {
-        ShiftParams params = reuse_shift_params();
 #if SHIFT_MODE == SHIFT_RECONNECTION
-        s = inverse ? inverse_reconnection(params, record, camera, v1) : shift_reconnection(params, record, camera, v1);
+        s = inverse_reconnection(reuse_shift_params(), record, camera, v1);
 #elif SHIFT_MODE == SHIFT_REPLAY
-        s = inverse ? inverse_random_replay(params, record, camera, v1) : shift_random_replay(params, record, camera, v1);
+        s = inverse_random_replay(reuse_shift_params(), record, camera, v1);
 #else
-        s = inverse ? inverse_hybrid(params, record, camera, v1) : shift_hybrid(params, record, camera, v1);
+        s = inverse_hybrid(reuse_shift_params(), record, camera, v1);
 #endif
     }
     if (!s.valid) local_shifts_failed += 1u;
@@ -147,7 +148,7 @@ Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
         bool wanted = forward || (l != i && needs_targets_from(i));
         bool shift = alive && wanted && !same_domain(from, to);
         ShiftResult shifted = shift_failed();
-        if (shift) shifted = shift_path(y, to, !forward);
+        if (shift) shifted = shift_path(y, to);
         if (forward) {
             if (shift && shifted.valid) {
                 y = shifted.record;

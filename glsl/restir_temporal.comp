@@ -6,7 +6,9 @@
 // unmoved camera, without shifts (restir_reuse.glsl), and as is for a moving one.
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+#include "shader_interface.glsl"
+
+layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
 #include "restir_reuse.glsl"
 

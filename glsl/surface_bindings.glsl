@@ -7,15 +7,18 @@
 #ifndef SURFACE_BINDINGS_GLSL
 #define SURFACE_BINDINGS_GLSL
 
+#include "shader_interface.glsl"
+
 #ifndef SCENE_SURFACE
 #define SCENE_SURFACE 0
 #endif
 #ifndef SCENE_TEXTURES
 #define SCENE_TEXTURES 0
 #endif
-// Oracle kernels, which bind everything in set 0, move these bindings there.
+// The set and the first binding of SurfaceBinding (src/shader_interface.rs). Oracle kernels,
+// which bind everything in set 0, move these bindings there.
 #ifndef SURFACE_SET
-#define SURFACE_SET 1
+#define SURFACE_SET SURFACE_DESCRIPTOR_SET
 #define SURFACE_BINDING 0
 #endif
 
@@ -64,19 +67,19 @@ const uint ALPHA_MASK = 1u;
 const uint ALPHA_BLEND = 2u;
 
 #if SCENE_SURFACE
-layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING) readonly buffer SurfaceAttributes {
+layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_SURFACE_ATTRIBUTES) readonly buffer SurfaceAttributes {
     TriangleSurface surface_attributes[];
 };
 #endif
 #if SCENE_TEXTURES
-layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + 1) readonly buffer MaterialTextureTable {
+layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_MATERIAL_TEXTURE_TABLE) readonly buffer MaterialTextureTable {
     MaterialTextures material_textures[];
 };
-layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + 2) readonly buffer TextureHeaders {
+layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_TEXTURE_HEADERS) readonly buffer TextureHeaders {
     TextureHeader texture_headers[];
 };
 // RGBA8 texels, R in the low byte.
-layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + 3) readonly buffer Texels { uint texels[]; };
+layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_TEXELS) readonly buffer Texels { uint texels[]; };
 #endif
 
 #endif

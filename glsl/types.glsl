@@ -2,6 +2,8 @@
 #ifndef TYPES_GLSL
 #define TYPES_GLSL
 
+#include "shader_interface.glsl"
+
 struct Material {
     vec3 base_color;
     float metallic;
@@ -10,6 +12,8 @@ struct Material {
     float transmission;
     float ior;
     uint flags;
+    float specular;        // KHR_materials_specular specularFactor; 0: no specular layer on non-metals
+    vec3 specular_color;   // KHR_materials_specular specularColorFactor (linear)
     uint pad;
 };
 const uint MATERIAL_DOUBLE_SIDED = 1u;
@@ -49,7 +53,6 @@ struct Emitter {
     uint alias;
 };
 const uint PUNCTUAL_LIGHT_BIT = 0x80000000u;
-const uint PUNCTUAL_ROWS = 4u;
 const uint PUNCTUAL_POINT = 0u;
 const uint PUNCTUAL_SPOT = 1u;
 const uint PUNCTUAL_DIRECTIONAL = 2u;

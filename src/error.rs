@@ -11,6 +11,10 @@ pub enum GpuError {
     Timeout { seconds: u64 },
     #[error("out of GPU memory while allocating {what} ({bytes} bytes)")]
     OutOfMemory { what: String, bytes: u64 },
+    /// The allocator refused for another reason than memory (no compatible memory type, a
+    /// failed map, an internal error): gpu-allocator's `AllocationError` other than `OutOfMemory`.
+    #[error("the GPU memory allocator could not allocate {what} ({bytes} bytes): {reason}")]
+    Allocation { what: String, bytes: u64, reason: String },
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per storage-buffer binding (maxStorageBufferRange)")]
     BindingTooLarge { what: String, needed: u64, limit: u64 },
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per allocation (maxMemoryAllocationSize)")]
@@ -32,5 +36,48 @@ pub fn vk_error(during: &'static str) -> impl FnOnce(vk::Result) -> GpuError {
             bytes: 0,
         },
         result => GpuError::Vulkan { during, result },
+    }
+}
+
+/// Maps gpu-allocator's error for an allocation named `what` of `bytes`: out-of-memory stays
+/// out-of-memory; every other kind (no compatible memory type, a failed map, invalid
+/// descriptions, internal errors) is reported as what it is.
+pub fn allocation_error(what: &str, bytes: u64, error: gpu_allocator::AllocationError) -> GpuError {
+    match error {
+        gpu_allocator::AllocationError::OutOfMemory => GpuError::OutOfMemory {
+            what: what.to_string(),
+            bytes,
+        },
+        other => GpuError::Allocation {
+            what: what.to_string(),
+            bytes,
+            reason: other.to_string(),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpu_allocator::AllocationError;
+
+    #[test]
+    fn allocation_errors_other_than_out_of_memory_keep_their_kind() {
+        let oom = allocation_error("accumulation", 64, AllocationError::OutOfMemory);
+        assert!(matches!(oom, GpuError::OutOfMemory { bytes: 64, .. }), "{oom}");
+        for (error, needle) in [
+            (AllocationError::NoCompatibleMemoryTypeFound, "No compatible memory type"),
+            (AllocationError::FailedToMap("denied".into()), "Failed to map memory: denied"),
+            (AllocationError::Internal("broken".into()), "Internal error: broken"),
+            (AllocationError::InvalidAllocationCreateDesc, "Invalid AllocationCreateDesc"),
+        ] {
+            let mapped = allocation_error("accumulation", 64, error);
+            let text = mapped.to_string();
+            assert!(matches!(mapped, GpuError::Allocation { .. }), "{text}");
+            assert!(
+                text.contains("accumulation") && text.contains(needle) && !text.contains("out of"),
+                "{text}"
+            );
+        }
     }
 }

@@ -15,6 +15,11 @@ pub struct Material {
     pub transmission: f32,
     pub ior: f32,
     pub flags: u32,
+    /// `KHR_materials_specular` specularFactor: the strength of the non-metal specular layer
+    /// (docs/materials.md); 0 makes the non-metal part purely Lambertian.
+    pub specular: f32,
+    /// `KHR_materials_specular` specularColorFactor (linear RGB), scaling the layer's F0.
+    pub specular_color: [f32; 3],
     pub pad: u32,
 }
 
@@ -131,9 +136,7 @@ pub struct FrameParams {
     pub emitter_count: u32,
 }
 
-/// The most passes a ReSTIR PT frame runs (RESTIR_MAX_PASSES in glsl/restir_bindings.glsl):
-/// initial, temporal, 3 spatial rounds and shading.
-pub const RESTIR_MAX_PASSES: usize = 6;
+pub use crate::shader_interface::RESTIR_MAX_PASSES;
 
 /// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: the frame's reuse
 /// parameters and its pass table.

@@ -11,5 +11,6 @@ pub mod image_io;
 pub mod metrics;
 pub mod render;
 pub mod scene;
+pub mod shader_interface;
 pub mod shading;
 pub mod vk;

@@ -1,6 +1,6 @@
 #!/bin/bash
-# restir-pt beside Mitsuba 3 (scalar_rgb and llvm_ad_rgb) on one job, in one run (README
-# "Performance"). Usage: [SPP=64] tools/bench_vs_mitsuba.sh [SCENE] [ROUNDS]; set BASE to another
+# restir-pt beside Mitsuba 3 (scalar_rgb and llvm_ad_rgb) on one job, in one run
+# (docs/performance.md). Usage: [SPP=64] tools/bench_vs_mitsuba.sh [SCENE] [ROUNDS]; set BASE to another
 # restir-pt binary (e.g. main's) to alternate it in. Needs `pip install mitsuba` and, for
 # llvm_ad_rgb on Debian 12, libllvm19 (DRJIT_LIBLLVM_PATH below).
 set -e

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Mitsuba 3 on restir-pt's benchmark job, for README "Performance" (a dev-time measurement tool,
+"""Mitsuba 3 on restir-pt's benchmark job, for docs/performance.md (a dev-time measurement tool,
 not a dependency of restir-pt).
 
 Converts a bundled glTF scene (flat node list; diffuse or emissive materials; the node named

@@ -1,5 +1,6 @@
 //! Fuzzes the glTF/GLB loader: any input may be rejected, none may panic or hang.
-//! Run: `cargo fuzz run load_scene fuzz/corpus/load_scene tests/data/bad scenes -- -max_total_time=60`.
+//! Run: `cargo fuzz run load_scene fuzz/corpus/load_scene tests/data/bad scenes -- -max_total_time=60`,
+//! or `tools/fuzz_corpus.sh grow 60` without cargo-fuzz.
 //! The suite replays fuzz/corpus/load_scene on every `cargo test --release`.
 #![no_main]
 

@@ -11,7 +11,7 @@ use glam::Vec3;
 use super::scene_path;
 use super::sweep::SweepMode;
 use crate::image_io::Exposure;
-use crate::render::{RenderSettings, RestirSettings, ReuseMis, ShiftKind};
+use crate::render::{History, RenderSettings, RestirSettings, ReuseMis, ShiftKind};
 use crate::scene::{ArrayLimit, LoadOptions};
 
 /// An on/off switch written `--flag on|off`.
@@ -65,6 +65,10 @@ pub struct RestirArgs {
     /// ReSTIR PT: reuse the previous frame's reservoirs.
     #[arg(long, value_enum, default_value_t = Toggle::from_bool(RestirSettings::default().temporal))]
     pub temporal: Toggle,
+    /// ReSTIR PT: the reservoirs the next frame's temporal reuse reads, those before spatial
+    /// reuse (temporal) or after it (spatial).
+    #[arg(long, value_enum, default_value_t = RestirSettings::default().history)]
+    pub history: History,
     /// ReSTIR PT: spatial neighbours per round (0 turns spatial reuse off; at most 8).
     #[arg(long, default_value_t = RestirSettings::default().spatial)]
     pub spatial: u32,
@@ -98,6 +102,7 @@ impl RestirArgs {
             shift: self.shift,
             mis: self.mis,
             temporal: self.temporal.on(),
+            history: self.history,
             spatial: self.spatial,
             radius: self.radius,
             rounds: self.rounds,
@@ -126,6 +131,11 @@ impl RestirArgs {
             set.temporal != default.temporal,
             "temporal",
             if set.temporal { "on" } else { "off" }.into(),
+        );
+        note(
+            set.history != default.history,
+            "history",
+            format!("{:?}", set.history).to_lowercase(),
         );
         note(set.spatial != default.spatial, "spatial", set.spatial.to_string());
         note(set.radius != default.radius, "radius", set.radius.to_string());
@@ -163,7 +173,8 @@ impl SceneArgs {
         scene_path(self.scene.as_deref())
     }
 
-    /// What to load besides the file; `array_limit` is the device's limit on one scene array.
+    /// What to load besides the file; `array_limit` is the device's limit on one scene array
+    /// (`Context::scene_array_limit`), None before a device is open.
     pub fn load_options(&self, array_limit: Option<ArrayLimit>) -> LoadOptions {
         LoadOptions {
             scene: self.scene_index,
@@ -285,17 +296,35 @@ pub fn parse_env(s: &str) -> Result<EnvArg, String> {
     parse_radiance(s).map(EnvArg::Constant)
 }
 
+/// R,G,B radiances; each error names the value and its first problem (negative values included:
+/// the option takes hyphen values so that `--env -1,0,0` reaches this check, not clap's).
 fn parse_radiance(s: &str) -> Result<Vec3, String> {
-    let usage = || format!("{s:?} must be R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr");
-    let values: Vec<f32> = s
-        .split(',')
-        .map(|v| v.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| usage())?;
-    match values[..] {
-        [r, g, b] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok(Vec3::new(r, g, b)),
-        _ => Err(usage()),
+    const USAGE: &str = "--env takes R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr";
+    if s.trim().is_empty() {
+        return Err(format!("the value is empty; {USAGE}"));
     }
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        let looks_like_file = s.contains('/')
+            || s.rsplit_once('.')
+                .is_some_and(|(_, ext)| ext.chars().any(|c| c.is_ascii_alphabetic()));
+        return Err(if looks_like_file {
+            format!("{s:?}: environment maps are read from .exr or .hdr files; {USAGE}")
+        } else {
+            format!("{s:?} has {} value(s); {USAGE}", parts.len())
+        });
+    }
+    let mut rgb = [0.0f32; 3];
+    for (value, part) in rgb.iter_mut().zip(&parts) {
+        *value = part.parse().map_err(|_| format!("{s:?}: {part:?} is not a number; {USAGE}"))?;
+        if !value.is_finite() {
+            return Err(format!("{s:?}: {part} is not a finite f32 radiance; {USAGE}"));
+        }
+        if *value < 0.0 {
+            return Err(format!("{s:?}: {part} is negative; {USAGE}"));
+        }
+    }
+    Ok(Vec3::from_array(rgb))
 }
 
 #[cfg(test)]

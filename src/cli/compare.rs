@@ -14,6 +14,7 @@ use super::args::{DeviceArgs, PathArgs, RestirArgs, SweepArgs};
 use super::compare_outputs::write_outputs;
 use super::method_spec::{parse_methods, MethodRenderer, MethodSpec, DEFAULT_METHODS};
 use super::reference_record::check_reference;
+use super::render_output::status_spinner;
 use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path};
 use crate::image_io::read_exr;
@@ -89,6 +90,14 @@ pub(super) enum Cost {
 }
 
 impl Cost {
+    /// What was measured, for the calibration line.
+    fn describe(&self) -> String {
+        match self {
+            Cost::Affine { fixed, per_sample } => format!("{fixed:.1} ms per frame + {per_sample:.2} ms per spp"),
+            Cost::PerReservoirs(ms) => format!("{:.1} ms per frame with 1 reservoir per pixel", ms[0]),
+        }
+    }
+
     /// The knob value that fits `budget_ms`, or None if even the cheapest frame does not.
     fn fit(&self, budget_ms: f64) -> Option<u32> {
         match self {
@@ -211,16 +220,28 @@ impl Run<'_> {
     }
 
     /// Measures ReSTIR PT frames with more reservoirs until one costs over `max_budget_ms` or
-    /// the most reservoirs are measured.
-    pub(super) fn extend(&self, renderer: &mut MethodRenderer, cost: &mut Cost, max_budget_ms: f64) -> Result<()> {
-        if let Cost::PerReservoirs(ms) = cost {
-            while ms.last().is_some_and(|&t| t <= max_budget_ms) && ms.len() < MAX_RESERVOIRS as usize {
-                renderer.set_cost_knob(ms.len() as u32 + 1)?;
-                ms.push(self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame);
-            }
+    /// the most reservoirs are measured. Returns the frame ms of the most reservoirs when even
+    /// they fit: larger budgets then run with the most and leave time unspent.
+    pub(super) fn extend(&self, renderer: &mut MethodRenderer, cost: &mut Cost, max_budget_ms: f64) -> Result<Option<f64>> {
+        let Cost::PerReservoirs(ms) = cost else {
+            return Ok(None);
+        };
+        while ms.last().is_some_and(|&t| t <= max_budget_ms) && ms.len() < MAX_RESERVOIRS as usize {
+            renderer.set_cost_knob(ms.len() as u32 + 1)?;
+            ms.push(self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame);
         }
-        Ok(())
+        Ok(ms
+            .last()
+            .copied()
+            .filter(|&t| t <= max_budget_ms && ms.len() == MAX_RESERVOIRS as usize))
     }
+}
+
+/// The notice that a method's reservoirs per pixel are capped below a budget.
+pub(super) fn reservoir_cap_note(label: &str, most_ms: f64) -> String {
+    format!(
+        "note: {label}: {MAX_RESERVOIRS} reservoirs per pixel (the most) take {most_ms:.1} ms per frame; budgets above that run with {MAX_RESERVOIRS} and leave time unspent"
+    )
 }
 
 /// What every mode of `compare` reads and checks before it opens a device.
@@ -330,34 +351,24 @@ fn compare_all(args: &CompareArgs, setup: &Setup) -> Result<Vec<CompareRow>> {
     let ctx = open_device(&args.device)?;
     let run = setup.run(args.camera_path);
     note_camera_path(args, &run);
+    let progress = status_spinner();
     let mut renderers = vec![];
     for m in &setup.methods {
+        progress.set_message(format!("compiling and calibrating {}", m.label()));
         let mut renderer = MethodRenderer::new(&ctx, &setup.scene, &setup.settings, m)?;
         let cost = run.calibrate(&mut renderer)?;
+        progress.suspend(|| eprintln!("{}: {}", m.label(), cost.describe()));
         renderers.push((m.label(), renderer, cost));
     }
-    let budgets = if args.budgets_ms.is_empty() {
-        let cheapest_restir = renderers
-            .iter()
-            .filter_map(|(_, _, c)| match c {
-                Cost::PerReservoirs(ms) => Some(ms[0]),
-                Cost::Affine { .. } => None,
-            })
-            .fold(f64::INFINITY, f64::min);
-        let unit = if cheapest_restir.is_finite() {
-            cheapest_restir * 1.05
-        } else {
-            10.0
-        };
-        vec![unit, 2.0 * unit, 4.0 * unit]
-    } else {
-        args.budgets_ms.clone()
-    };
-
+    let budgets = default_budgets(args, &renderers);
     let max_budget = budgets.iter().copied().fold(0.0, f64::max);
-    for (_, renderer, cost) in &mut renderers {
-        run.extend(renderer, cost, max_budget)?;
+    for (label, renderer, cost) in &mut renderers {
+        progress.set_message(format!("calibrating {label} with more reservoirs"));
+        if let Some(most_ms) = run.extend(renderer, cost, max_budget)? {
+            progress.suspend(|| eprintln!("{}", reservoir_cap_note(label, most_ms)));
+        }
     }
+    progress.finish_and_clear();
 
     let mut rows = vec![];
     let mut images: Vec<(String, f64, Image)> = vec![];
@@ -373,6 +384,28 @@ fn compare_all(args: &CompareArgs, setup: &Setup) -> Result<Vec<CompareRow>> {
     finish_device(&ctx)?;
     write_outputs(args, setup, &budgets, &rows, &images, &ctx.info.name)?;
     Ok(rows)
+}
+
+/// --budgets-ms, or ReSTIR PT's cheapest frame (of all ReSTIR methods) times 1.05, 2.1 and 4.2
+/// (10, 20 and 40 ms without a ReSTIR method).
+fn default_budgets(args: &CompareArgs, renderers: &[(String, MethodRenderer, Cost)]) -> Vec<f64> {
+    if args.budgets_ms.is_empty() {
+        let cheapest_restir = renderers
+            .iter()
+            .filter_map(|(_, _, c)| match c {
+                Cost::PerReservoirs(ms) => Some(ms[0]),
+                Cost::Affine { .. } => None,
+            })
+            .fold(f64::INFINITY, f64::min);
+        let unit = if cheapest_restir.is_finite() {
+            cheapest_restir * 1.05
+        } else {
+            10.0
+        };
+        vec![unit, 2.0 * unit, 4.0 * unit]
+    } else {
+        args.budgets_ms.clone()
+    }
 }
 
 /// A reference needs several times the samples of the frames measured against it, or its own

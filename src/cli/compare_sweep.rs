@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 
-use super::compare::{measure, note_camera_path, CompareArgs, CompareRow, Setup};
+use super::compare::{measure, note_camera_path, reservoir_cap_note, CompareArgs, CompareRow, Setup};
 use super::compare_outputs::{write_csv, write_outputs};
 use super::method_spec::MethodRenderer;
 use super::sweep::{
@@ -55,7 +55,9 @@ fn run_job(args: &CompareArgs, setup: &Setup, k: usize, labels: &[String]) -> Re
     note_camera_path(args, &run);
     let mut renderer = MethodRenderer::new(&ctx, &setup.scene, &setup.settings, method)?;
     let mut cost = run.calibrate(&mut renderer)?;
-    run.extend(&mut renderer, &mut cost, budget)?;
+    if let Some(most_ms) = run.extend(&mut renderer, &mut cost, budget)? {
+        eprintln!("{}", reservoir_cap_note(&method.label(), most_ms));
+    }
     let measured = measure(&run, &mut renderer, &cost, &method.label(), budget, &setup.reference, args)?;
     let compile_ms = renderer.compile_ms();
     drop(renderer);

@@ -48,18 +48,11 @@ impl MethodSpec {
             Some((s, m)) => (s, Some(m)),
             None => (rest, None),
         };
-        settings.shift = match shift {
-            "reconnection" => ShiftKind::Reconnection,
-            "replay" => ShiftKind::Replay,
-            "hybrid" => ShiftKind::Hybrid,
-            other => bail!("method '{text}': unknown shift '{other}' (reconnection, replay or hybrid)"),
-        };
+        settings.shift = ShiftKind::from_name(shift)
+            .ok_or_else(|| anyhow::anyhow!("method '{text}': unknown shift '{shift}' (reconnection, replay or hybrid)"))?;
         if let Some(mis) = mis {
-            settings.mis = match mis {
-                "gbh" => ReuseMis::GeneralizedBalance,
-                "pairwise" => ReuseMis::Pairwise,
-                other => bail!("method '{text}': unknown MIS '{other}' (gbh or pairwise)"),
-            };
+            settings.mis =
+                ReuseMis::from_name(mis).ok_or_else(|| anyhow::anyhow!("method '{text}': unknown MIS '{mis}' (gbh or pairwise)"))?;
         }
         Ok(MethodSpec::Restir(settings))
     }

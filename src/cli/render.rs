@@ -115,7 +115,7 @@ impl RenderArgs {
             MethodArg::Pt => {
                 let ignored = self.restir.changed_flags();
                 if !ignored.is_empty() {
-                    eprintln!("warning: {} set ReSTIR PT and are ignored by --method pt", ignored.join(", "));
+                    eprintln!("warning: --method pt ignores the ReSTIR PT options {}", ignored.join(", "));
                 }
             }
         }
@@ -239,7 +239,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     }
     args.check_method_flags()?;
     let path = args.scene.path();
-    // The device first: its per-binding limit lets the loader refuse an oversized scene from its
+    // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;
     let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.scene_array_limit())))?;
@@ -367,5 +367,22 @@ fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
             return Ok(report);
         }
         frame += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn render_without_arguments_takes_the_library_defaults() {
+        let args = RenderArgs::parse_defaults().unwrap();
+        assert_eq!((args.method, args.frames, args.static_camera), (MethodArg::Restir, 1, false));
+        assert_eq!(args.path.max_depth, RenderSettings::DEFAULT_MAX_DEPTH);
+        assert_eq!(args.restir_settings(), Some(RestirSettings::default()));
+        assert_eq!(args.russian_roulette, None);
+        let pt: RenderArgs = super::super::parse_args(&["--method", "pt", "--russian-roulette", "off", "--exposure", "-1.5"]).unwrap();
+        assert_eq!((pt.restir_settings(), pt.russian_roulette), (None, Some(Toggle::Off)));
+        assert_eq!(pt.exposure, Exposure::Ev(-1.5));
     }
 }

@@ -180,6 +180,14 @@ pub fn compile_progress() -> indicatif::ProgressBar {
     bar
 }
 
+/// A spinner with a message and the time elapsed, for long steps without a count.
+pub fn status_spinner() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(indicatif::ProgressStyle::with_template("{spinner} {msg}  {elapsed}").expect("static template is valid"));
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
 /// The start-up line: how long compiling the kernels took.
 pub fn print_compile_summary(kernels: &[crate::vk::KernelCompile]) {
     let total: f64 = kernels.iter().map(|k| k.total_ms()).sum();

@@ -3,8 +3,7 @@
 
 use serde::Serialize;
 
-/// Counters of glsl/counters.glsl, in its order (COUNTER_TRAVERSALS ... COUNTER_STEP_ITERATIONS).
-pub const COUNTER_COUNT: usize = 7;
+pub use crate::shader_interface::COUNTER_COUNT;
 
 /// Totals over one or more dispatches. "Lane" counts are per invocation; "iterations" are per
 /// subgroup (llvmpipe: one SIMD group of `subgroup_size` lanes in lockstep).

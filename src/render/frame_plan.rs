@@ -26,6 +26,17 @@ impl PassKernel {
         PassKernel::Shade,
     ];
 
+    /// The GLSL file and extra `#define`s of the kernel.
+    pub fn source(self) -> (&'static str, &'static [(&'static str, &'static str)]) {
+        match self {
+            PassKernel::Initial => ("restir_initial.comp", &[]),
+            PassKernel::Temporal => ("restir_temporal.comp", &[]),
+            PassKernel::TemporalUnmoved => ("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")]),
+            PassKernel::Spatial => ("restir_spatial.comp", &[]),
+            PassKernel::Shade => ("restir_shade.comp", &[]),
+        }
+    }
+
     /// The timer slot of the pass (an index into `PASS_NAMES`).
     pub fn timer_slot(self) -> usize {
         match self {
@@ -53,6 +64,20 @@ pub struct FrameState {
     pub surface_slot: u32,
     /// Spatial reuse rounds (0 to 3).
     pub spatial_rounds: u32,
+    /// Which reservoirs the next frame's temporal reuse reads.
+    pub history: History,
+}
+
+/// The reservoirs a frame leaves as the next frame's history.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum History {
+    /// The reservoirs before spatial reuse (the initial or temporal pass's output), as ReSTIR GI
+    /// keeps its temporal and spatial reservoirs apart (Ouyang et al. 2021): a path that spatial
+    /// reuse copies into a neighbour is not carried on in the neighbour's history, so a rare
+    /// bright path does not spread from pixel to pixel frame after frame.
+    Temporal,
+    /// The reservoirs after the last spatial round (Bitterli et al. 2020; Lin et al. 2022).
+    Spatial,
 }
 
 /// One dispatch of a frame.
@@ -62,7 +87,7 @@ pub struct PlannedPass {
     pub slots: RestirPass,
 }
 
-/// A frame's dispatches, and the slot its final reservoirs end in (the next frame's history).
+/// A frame's dispatches, and the slot of the reservoirs the next frame's temporal reuse reads.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FramePlan {
     pub passes: Vec<PlannedPass>,
@@ -73,7 +98,9 @@ const TEMPORAL_SEED: u32 = 0x7e3a_11c5;
 const SPATIAL_SEED: u32 = 0x5bd1_e995;
 
 /// Plans a frame: initial candidates into a free slot, temporal reuse when a history exists,
-/// the spatial rounds, then shading of the last result. The history's slot is never written.
+/// the spatial rounds, then shading of the last result. The history's slot is never written
+/// before the temporal pass has read it; with `History::Temporal` the spatial rounds alternate
+/// between the two slots other than the one they start from, which stays the next history.
 pub fn plan_frame(state: &FrameState) -> FramePlan {
     // The previous frame's result keeps its slot; the passes alternate between the other two.
     let prev_slot = state.history_slot.unwrap_or(RESERVOIR_SLOTS as u32 - 1);
@@ -102,21 +129,32 @@ pub fn plan_frame(state: &FrameState) -> FramePlan {
         });
         current = 1 - current;
     }
+    let kept = work[current];
+    // With the history kept, the previous frame's slot is free once the temporal pass has read it.
+    let spatial_slots = match state.history {
+        History::Spatial => [work[1 - current], work[current]],
+        History::Temporal => [work[1 - current], prev_slot],
+    };
+    let mut last = kept;
     for round in 0..state.spatial_rounds {
+        let out = spatial_slots[(round % 2) as usize];
         passes.push(PlannedPass {
             kernel: PassKernel::Spatial,
-            slots: slots(work[current], work[1 - current], SPATIAL_SEED ^ (round + 1)),
+            slots: slots(last, out, SPATIAL_SEED ^ (round + 1)),
         });
-        current = 1 - current;
+        last = out;
     }
     passes.push(PlannedPass {
         kernel: PassKernel::Shade,
-        slots: slots(work[current], work[current], 0),
+        slots: slots(last, last, 0),
     });
     debug_assert!(passes.len() <= RESTIR_MAX_PASSES);
     FramePlan {
         passes,
-        final_slot: work[current],
+        final_slot: match state.history {
+            History::Spatial => last,
+            History::Temporal => kept,
+        },
     }
 }
 
@@ -140,6 +178,7 @@ mod tests {
             unmoved,
             surface_slot: 1,
             spatial_rounds,
+            history: History::Spatial,
         }
     }
 
@@ -181,6 +220,37 @@ mod tests {
                     let shade = plan.passes.last().expect("a plan ends with shading");
                     assert_eq!(shade.kernel, PassKernel::Shade);
                     assert_eq!(shade.slots.in_slot, plan.final_slot);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn temporal_history_is_the_pre_spatial_reservoir_and_no_later_pass_writes_it() {
+        for history in [None, Some(0), Some(1), Some(2)] {
+            for rounds in 0..=3 {
+                let plan = plan_frame(&FrameState {
+                    history: History::Temporal,
+                    ..state(history, false, rounds)
+                });
+                let reuse = if history.is_some() { 2 } else { 1 };
+                let kept = plan.passes[reuse - 1].slots.out_slot;
+                assert_eq!(plan.final_slot, kept);
+                assert_eq!(plan.passes.len(), reuse + 1 + rounds as usize);
+                for pass in &plan.passes[..reuse] {
+                    assert!(history.is_none_or(|h| pass.slots.out_slot != h));
+                }
+                for pass in &plan.passes[reuse..] {
+                    assert!(pass.slots.out_slot != kept || pass.kernel == PassKernel::Shade && rounds == 0);
+                }
+                for pair in plan.passes.windows(2) {
+                    assert_eq!(pair[1].slots.in_slot, pair[0].slots.out_slot);
+                }
+                // One round gives the same passes as the spatial history; only the next
+                // frame's history differs.
+                if rounds == 1 {
+                    let spatial = plan_frame(&state(history, false, rounds));
+                    assert_eq!(spatial.passes, plan.passes);
                 }
             }
         }

@@ -3,6 +3,7 @@
 mod counters;
 mod frame_plan;
 mod image;
+mod image_readback;
 mod path_tracer;
 mod reservoir_layers;
 mod restir;
@@ -12,7 +13,7 @@ mod settings;
 mod surface_gpu;
 
 pub use counters::TraversalCounters;
-pub use frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PlannedPass, PASS_NAMES};
+pub use frame_plan::{plan_frame, FramePlan, FrameState, History, PassKernel, PlannedPass, PASS_NAMES};
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir};

@@ -7,10 +7,12 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 
 use super::counters::{TraversalCounters, COUNTER_COUNT};
+use super::image_readback::AccumReadback;
 use super::{Image, RenderSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::scene::Scene;
+use crate::shader_interface::{PathTraceBinding, IMAGE_LOCAL_SIZE};
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
 /// Submissions are sized to about this much GPU time, which keeps GPU watchdogs far away.
@@ -28,7 +30,7 @@ const LOOP_BUDGET_SHARE: f64 = 0.25;
 const STATUS_WORDS: u64 = 5 + 2 * COUNTER_COUNT as u64;
 /// The first word of the profile counters in the Status block.
 const COUNTER_WORDS_START: usize = 4;
-const LOCAL_SIZE: u32 = 8;
+const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
 pub struct RenderStats {
     pub spp: u32,
@@ -50,8 +52,7 @@ impl RenderStats {
     }
 }
 
-/// Per-pixel vec4 accumulations, row-major.
-pub type PixelSums = Vec<[f32; 4]>;
+pub use super::image_readback::PixelSums;
 
 pub struct PathTracer {
     ctx: Arc<Context>,
@@ -60,6 +61,8 @@ pub struct PathTracer {
     accum: Buffer,
     accum_sq: Buffer,
     status: Buffer,
+    /// The image and the dispatch status come back through it.
+    readback: AccumReadback,
     _scene_gpu: SceneGpu,
     timer: PassTimer,
     settings: RenderSettings,
@@ -93,7 +96,7 @@ impl PathTracer {
         let accum_sq = Buffer::new(ctx, "accumulation of squares", pixels * 16, BufferUsage::Storage)?;
         let status = Buffer::new(ctx, "dispatch status", STATUS_WORDS * 4, BufferUsage::Storage)?;
         let mut bindings = scene_gpu.bindings();
-        bindings.extend([Binding::Storage, Binding::Storage, Binding::Storage]);
+        bindings.extend(PathTraceBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
         let mut defines = scene_gpu.defines();
         if scene_gpu.uniform && scene.triangles.len() <= BRUTE_FORCE_MAX_TRIANGLES {
             defines.push(("SCENE_BRUTE_FORCE", "1"));
@@ -103,8 +106,12 @@ impl PathTracer {
         }
         let mut kernel = scene_gpu.kernel(ctx, "pathtrace.comp", &defines, bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
-        buffers.extend([&accum, &accum_sq, &status]);
-        kernel.bind(&buffers);
+        buffers.extend([
+            PathTraceBinding::Accum.to(&accum),
+            PathTraceBinding::AccumSq.to(&accum_sq),
+            PathTraceBinding::Status.to(&status),
+        ]);
+        kernel.bind(&buffers)?;
         // One dispatch over zero pixels compiles the kernel now (llvmpipe compiles at the first
         // dispatch), so that no sample's GPU time includes it.
         let empty = crate::gpu_types::FrameParams::default();
@@ -119,6 +126,7 @@ impl PathTracer {
             accum,
             accum_sq,
             status,
+            readback: AccumReadback::new(ctx, settings.width, settings.height, STATUS_WORDS * 4)?,
             timer: PassTimer::new(ctx, 1)?,
             base_params: settings.frame_params(scene),
             settings: settings.clone(),
@@ -194,9 +202,11 @@ impl PathTracer {
                 self.timer.record_begin(cmd, 0);
                 self.kernel.record_dispatch(cmd, groups, &[]);
                 self.timer.record_end(cmd, 0);
+                record_compute_barrier(&self.ctx.device, cmd);
+                self.readback.record_counters(cmd, &self.status);
             })
             .context("path tracing")?;
-        let status = self.status.read::<u32>(STATUS_WORDS as usize)?;
+        let status = self.readback.counters::<u32>(STATUS_WORDS as usize)?;
         let (iterations, cut_groups, nonfinite) = (status[0], status[1], status[2]);
         if cut_groups > 0 {
             let limit = self.ctx.info.loop_iteration_limit.unwrap_or(0);
@@ -276,11 +286,11 @@ impl PathTracer {
     /// The accumulation buffers as they are: per pixel `[sum r, sum g, sum b, samples]` and
     /// `[sum r^2, sum g^2, sum b^2, 0]` of the radiance of its paths, row-major.
     pub fn sums(&self) -> Result<(PixelSums, PixelSums)> {
-        let n = self.settings.pixel_count();
-        Ok((self.accum.read(n)?, self.accum_sq.read(n)?))
+        Ok(self.readback.sums(&self.accum, &self.accum_sq)?)
     }
 
+    /// The mean of the samples so far, with its variance.
     pub fn image(&self) -> Result<Image> {
-        Ok(Image::read_accumulation(&self.settings, &self.accum, &self.accum_sq)?)
+        Ok(self.readback.image(&self.accum, &self.accum_sq)?)
     }
 }

@@ -8,7 +8,7 @@ use anyhow::Result;
 use crate::gpu_types::{ReservoirHead, ReservoirTail};
 use crate::vk::{Buffer, BufferUsage, Context};
 
-pub const RESERVOIR_SLOTS: usize = 3;
+pub use crate::shader_interface::RESERVOIR_SLOTS;
 
 pub struct ReservoirLayers {
     pub heads: [Buffer; RESERVOIR_SLOTS],

@@ -2,27 +2,39 @@
 
 use anyhow::{bail, Result};
 
+use super::frame_plan::History;
 use crate::shading::path_record::MAX_PATH_LENGTH;
 
-/// The shift mapping used for reuse (and, inverted, for its MIS weights).
+/// The shift mapping used for reuse (and, inverted, for its MIS weights). The discriminant is
+/// the value of the kernels' SHIFT_MODE (src/shader_interface.rs writes the GLSL names).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[repr(u32)]
 pub enum ShiftKind {
-    Reconnection,
-    Replay,
-    Hybrid,
+    Reconnection = 0,
+    Replay = 1,
+    Hybrid = 2,
 }
 
-/// The resampling MIS weights of reuse (`--mis gbh|pairwise`).
+/// The resampling MIS weights of reuse (`--mis gbh|pairwise`). The discriminant is the value of
+/// the kernels' MIS_MODE.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[repr(u32)]
 pub enum ReuseMis {
-    /// Generalized balance heuristic with confidence weights (O(M^2) shifts).
+    /// Generalized balance heuristic with confidence weights, O(M^2) inverse shifts.
     #[value(name = "gbh")]
-    GeneralizedBalance,
-    /// Defensive pairwise MIS (O(M) shifts).
-    Pairwise,
+    GeneralizedBalance = 0,
+    /// Defensive pairwise MIS, O(M).
+    Pairwise = 1,
 }
 
 impl ShiftKind {
+    pub const ALL: [ShiftKind; 3] = [ShiftKind::Reconnection, ShiftKind::Replay, ShiftKind::Hybrid];
+
+    /// The kind called `name` (`reconnection`, `replay` or `hybrid`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             ShiftKind::Reconnection => "reconnection",
@@ -31,17 +43,24 @@ impl ShiftKind {
         }
     }
 
-    /// The SHIFT_MODE value of glsl/restir_reuse.glsl.
-    fn define(self) -> &'static str {
+    /// The GLSL macro of this kind, a value of SHIFT_MODE in glsl/restir_reuse.glsl.
+    pub fn glsl_name(self) -> &'static str {
         match self {
-            ShiftKind::Reconnection => "0",
-            ShiftKind::Replay => "1",
-            ShiftKind::Hybrid => "2",
+            ShiftKind::Reconnection => "SHIFT_RECONNECTION",
+            ShiftKind::Replay => "SHIFT_REPLAY",
+            ShiftKind::Hybrid => "SHIFT_HYBRID",
         }
     }
 }
 
 impl ReuseMis {
+    pub const ALL: [ReuseMis; 2] = [ReuseMis::GeneralizedBalance, ReuseMis::Pairwise];
+
+    /// The MIS called `name` (`gbh` or `pairwise`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             ReuseMis::GeneralizedBalance => "gbh",
@@ -49,18 +68,16 @@ impl ReuseMis {
         }
     }
 
-    /// The MIS_MODE value of glsl/restir_reuse.glsl.
-    fn define(self) -> &'static str {
+    /// The GLSL macro of this MIS, a value of MIS_MODE in glsl/restir_reuse.glsl.
+    pub fn glsl_name(self) -> &'static str {
         match self {
-            ReuseMis::GeneralizedBalance => "0",
-            ReuseMis::Pairwise => "1",
+            ReuseMis::GeneralizedBalance => "MIS_GBH",
+            ReuseMis::Pairwise => "MIS_PAIRWISE",
         }
     }
 }
 
-/// Most spatial neighbours per round (glsl/restir_reuse.glsl's MAX_INPUTS - 1).
-pub const MAX_NEIGHBOURS: u32 = 8;
-pub const MAX_ROUNDS: u32 = 3;
+pub use crate::shader_interface::{MAX_NEIGHBOURS, MAX_SPATIAL_ROUNDS as MAX_ROUNDS};
 pub const MAX_CANDIDATES: u32 = 64;
 pub const MAX_EMISSION_RAYS: u32 = 64;
 pub const MAX_RESERVOIRS: u32 = 16;
@@ -88,6 +105,9 @@ pub struct RestirSettings {
     /// reservoir's paths, so extra rays cut its anti-aliasing noise (a light's edge seen by one
     /// jittered ray) without bias, at the cost of one closest-hit trace each.
     pub emission_rays: u32,
+    /// Which reservoirs the next frame's temporal reuse reads: those before spatial reuse or
+    /// after it (docs/restir.md, "Which reservoirs are the history").
+    pub history: History,
     pub normal_threshold: f32,
     pub depth_threshold: f32,
 }
@@ -105,6 +125,7 @@ impl Default for RestirSettings {
             candidates: 1,
             reservoirs: 1,
             emission_rays: 4,
+            history: History::Spatial,
             normal_threshold: 0.9,
             depth_threshold: 0.1,
         }
@@ -160,7 +181,7 @@ impl RestirSettings {
 
     /// The `#define`s that select the shift and the MIS in the reuse kernels.
     pub fn defines(&self) -> [(&'static str, &'static str); 2] {
-        [("SHIFT_MODE", self.shift.define()), ("MIS_MODE", self.mis.define())]
+        [("SHIFT_MODE", self.shift.glsl_name()), ("MIS_MODE", self.mis.glsl_name())]
     }
 
     /// A short label such as `restir:hybrid/gbh`, with `@sK` when the spatial neighbours are not

@@ -14,9 +14,10 @@ use ash::vk::PhysicalDeviceType;
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
-use crate::shading::bsdf::lobe_weights;
+use crate::shader_interface::SceneBinding;
+use crate::shading::bsdf::{has_specular_layer, lobe_weights};
 use crate::shading::texture::NO_TEXTURE;
-use crate::vk::{Binding, Buffer, BufferUsage, Context, Kernel};
+use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context, Kernel};
 
 use super::surface_gpu::SurfaceGpu;
 
@@ -128,37 +129,54 @@ impl SceneGpu {
         self.addresses.is_some()
     }
 
-    /// The buffers for bindings 0-4, the frame parameters first.
-    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<&'a Buffer> {
-        match &self.addresses {
-            Some([triangles, nodes, emitters]) => vec![params, triangles, nodes, &self.materials, emitters],
-            None => vec![params, &self.triangles, &self.nodes, &self.materials, &self.emitters],
-        }
-    }
-
-    /// The descriptor kinds of bindings 0-4.
-    pub fn bindings(&self) -> Vec<Binding> {
+    /// The buffers of bindings 0-4, with `params` as the frame parameters. In the addressed
+    /// layout bindings 1, 2 and 4 hold the arrays' addresses.
+    pub fn buffers<'a>(&'a self, params: &'a Buffer) -> Vec<BoundBuffer<'a>> {
         let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
-        vec![Binding::Storage, scene, scene, scene, scene]
+        let [triangles, nodes, emitters] = match &self.addresses {
+            Some([t, n, e]) => [t, n, e],
+            None => [&self.triangles, &self.nodes, &self.emitters],
+        };
+        vec![
+            SceneBinding::FrameParams.to(params),
+            SceneBinding::Triangles.slot(scene).to(triangles),
+            SceneBinding::Nodes.slot(scene).to(nodes),
+            SceneBinding::Materials.slot(scene).to(&self.materials),
+            SceneBinding::Emitters.slot(scene).to(emitters),
+        ]
     }
 
-    /// The bindings of each descriptor set of a scene kernel whose set 0 is `set0`: set 1 holds
-    /// the surface attributes and textures when the scene has them.
-    pub fn sets(&self, set0: Vec<Binding>) -> Vec<Vec<Binding>> {
-        let mut sets = vec![set0];
+    /// The layout of bindings 0-4: the frame parameters in a storage buffer, the scene arrays
+    /// in uniform or storage buffers (`uniform`).
+    pub fn bindings(&self) -> Vec<BindingSlot> {
+        let scene = if self.uniform { Binding::Uniform } else { Binding::Storage };
+        SceneBinding::ALL
+            .iter()
+            .map(|&b| b.slot(if b == SceneBinding::FrameParams { Binding::Storage } else { scene }))
+            .collect()
+    }
+
+    /// The layout of a scene kernel whose set 0 is `set0`: set 1 (`SurfaceBinding`) holds the
+    /// surface attributes and textures when the scene has them.
+    pub fn layout(&self, mut set0: Vec<BindingSlot>) -> Vec<BindingSlot> {
         if let Some(s) = &self.surface {
-            sets.push(s.bindings());
+            set0.extend(s.bindings());
         }
-        sets
+        set0
     }
 
     /// Builds scene kernel glsl/`name` with set 0 `set0` (bound by the caller) and binds set 1.
-    pub fn kernel(&self, ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], set0: Vec<Binding>, push_bytes: u32) -> Result<Kernel> {
-        let sets = self.sets(set0);
-        let refs: Vec<&[Binding]> = sets.iter().map(Vec::as_slice).collect();
-        let kernel = Kernel::with_sets(ctx, name, defines, &refs, push_bytes)?;
+    pub fn kernel(
+        &self,
+        ctx: &Arc<Context>,
+        name: &str,
+        defines: &[(&str, &str)],
+        set0: Vec<BindingSlot>,
+        push_bytes: u32,
+    ) -> Result<Kernel> {
+        let kernel = Kernel::new(ctx, name, defines, &self.layout(set0), push_bytes)?;
         if let Some(s) = &self.surface {
-            kernel.bind_set(1, &s.buffers.iter().collect::<Vec<_>>());
+            kernel.bind(&s.bound())?;
         }
         Ok(kernel)
     }
@@ -194,6 +212,8 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("BSDF_DIFFUSE", flag(used(|w| w.0))),
         ("BSDF_CONDUCTOR", flag(used(|w| w.1))),
         ("BSDF_DIELECTRIC", flag(used(|w| w.2))),
+        // The layer needs a non-metal lobe, which a metallic texture can give a metal factor.
+        ("BSDF_SPECULAR", flag(variants.iter().any(has_specular_layer))),
         ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
         ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),

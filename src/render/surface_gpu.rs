@@ -6,7 +6,8 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 
 use crate::scene::Scene;
-use crate::vk::{Binding, Buffer, Context};
+use crate::shader_interface::SurfaceBinding;
+use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, Context};
 
 /// Set 1's buffers: the per-triangle attributes, then (with textures) the material texture
 /// table, the texture headers and the texels.
@@ -65,7 +66,20 @@ impl SurfaceGpu {
         }))
     }
 
-    pub fn bindings(&self) -> Vec<Binding> {
-        vec![Binding::Storage; self.buffers.len()]
+    /// Set 1's layout: the attributes, then the three texture bindings when uploaded.
+    pub fn bindings(&self) -> Vec<BindingSlot> {
+        SurfaceBinding::ALL[..self.buffers.len()]
+            .iter()
+            .map(|b| b.slot(Binding::Storage))
+            .collect()
+    }
+
+    /// Set 1's buffers, each at its `SurfaceBinding`.
+    pub fn bound(&self) -> Vec<BoundBuffer<'_>> {
+        SurfaceBinding::ALL
+            .iter()
+            .zip(&self.buffers)
+            .map(|(b, buffer)| b.to(buffer))
+            .collect()
     }
 }

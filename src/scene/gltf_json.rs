@@ -5,6 +5,7 @@
 //! not know, is read from the raw JSON; external buffer files are checked to exist so that a
 //! missing one is named.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -56,12 +57,16 @@ fn describe_extension(name: &str) -> &'static str {
 const GLB_MAGIC: &[u8; 4] = b"glTF";
 const GLB_HEADER_BYTES: usize = 12;
 
+/// A file's JSON and, for GLB, its binary chunk.
+type GltfChunks<'a> = (Cow<'a, [u8]>, Option<Vec<u8>>);
+
 /// Splits GLB into its JSON and binary chunks, or takes the bytes as glTF JSON. A GLB header whose
 /// length is shorter than the header itself makes the gltf crate's subtraction overflow (found by
 /// fuzzing), so it is checked first.
-fn split_glb(bytes: &[u8], path: &Path) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
+fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<GltfChunks<'a>> {
     if !bytes.starts_with(GLB_MAGIC) {
-        return Ok((bytes.to_vec(), None));
+        // Borrowed: a .gltf with embedded data can be hundreds of megabytes.
+        return Ok((Cow::Borrowed(bytes), None));
     }
     let declared = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
     match declared {
@@ -79,14 +84,26 @@ fn split_glb(bytes: &[u8], path: &Path) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
         )),
     }
     let glb = gltf::Glb::from_slice(bytes).map_err(|e| problem(path, format!("invalid GLB: {e}")))?;
-    Ok((glb.json.into_owned(), glb.bin.map(|b| b.into_owned())))
+    Ok((Cow::Owned(glb.json.into_owned()), glb.bin.map(|b| b.into_owned())))
 }
 
 /// Reads the JSON and applies the checks and removals described in the module comment;
 /// `warn` receives each warning (without the file name).
 pub(super) fn read_raw(bytes: &[u8], path: &Path, warn: &mut dyn FnMut(String)) -> Result<RawGltf> {
     let (json_bytes, blob) = split_glb(bytes, path)?;
-    let mut json: Value = serde_json::from_slice(&json_bytes).map_err(|e| problem(path, format!("invalid glTF: {e}")))?;
+    let mut json: Value = serde_json::from_slice(&json_bytes).map_err(|e| {
+        // Past leading white space JSON text starts with a bracket; anything else is another
+        // kind of file (an image, an OBJ, a Blender file), which a parser's position says little about.
+        let first = json_bytes.iter().find(|b| !b.is_ascii_whitespace());
+        match first {
+            Some(b'{' | b'[') => problem(path, format!("invalid glTF: {e}")),
+            None => problem(path, "the file is empty, not a glTF file"),
+            Some(_) => problem(
+                path,
+                "not a glTF file: neither glTF JSON (.gltf) nor binary glTF (.glb); convert it to glTF 2.0",
+            ),
+        }
+    })?;
     if !json.is_object() {
         bail!(problem(path, "invalid glTF: the top level is not a JSON object"));
     }

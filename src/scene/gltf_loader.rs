@@ -1,6 +1,7 @@
 //! glTF 2.0 (.gltf and .glb) to [`Scene`]. The data is checked, not only the JSON: every problem
 //! is an error or a warning that names the file.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -99,27 +100,45 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 pub fn load_scene_reporting(path: &Path, options: &LoadOptions, warnings: &mut Vec<String>) -> Result<Scene> {
     let bytes = std::fs::read(path).map_err(|e| problem(path, format!("cannot read the file: {e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
-    load_bytes_reporting(&bytes, Some(&base), path, options, warnings)
+    let parts = load_parts(Cow::Owned(bytes), Some(&base), path, options, warnings)?;
+    build_scene(parts, warnings)
 }
 
 /// Loads glTF or GLB bytes; external buffers resolve against `base` (none: only embedded data).
 /// `path` names the input in messages.
 pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> Result<Scene> {
-    load_bytes_reporting(bytes, base, path, &LoadOptions::default(), &mut Vec::new())
+    let mut warnings = Vec::new();
+    let parts = load_parts(Cow::Borrowed(bytes), base, path, &LoadOptions::default(), &mut warnings)?;
+    build_scene(parts, &warnings)
 }
 
-fn load_bytes_reporting(
-    bytes: &[u8],
+/// The scene's parts and the world position of its origin (`Scene::origin`).
+type LoadedParts = (SceneParts, DVec3);
+
+fn build_scene((parts, origin): LoadedParts, warnings: &[String]) -> Result<Scene> {
+    let mut scene = Scene::build(parts);
+    scene.origin = origin;
+    scene.warnings = warnings.to_vec();
+    Ok(scene)
+}
+
+/// Everything but the BVH build, so that the parsed document and its decoded buffers (as large as
+/// the triangles for embedded data) are freed before it. Host memory is held to one copy of each
+/// large thing at a time: the file is freed once parsed, a base64 buffer once decoded.
+fn load_parts(
+    bytes: Cow<[u8]>,
     base: Option<&Path>,
     path: &Path,
     options: &LoadOptions,
     warnings: &mut Vec<String>,
-) -> Result<Scene> {
+) -> Result<LoadedParts> {
     let mut warn = |w: String| warnings.push(format!("{}: {w}", path.display()));
-    let raw = read_raw(bytes, path, &mut warn)?;
+    let raw = read_raw(&bytes, path, &mut warn)?;
+    drop(bytes);
     check_external_buffers(&raw.json, base, path)?;
     let document = parse_gltf(raw.json, path)?;
     let buffers = gltf::import_buffers(&document, base, raw.blob).map_err(|e| problem(path, format!("cannot load buffer data: {e}")))?;
+    let document = without_buffer_uris(document);
     for (i, (data, buffer)) in buffers.iter().zip(document.buffers()).enumerate() {
         if data.len() < buffer.length() {
             bail!(problem(
@@ -152,9 +171,7 @@ fn load_bytes_reporting(
     };
     let result = loader.run(options);
     warnings.append(&mut loader.warnings);
-    let mut scene = result?;
-    scene.warnings = warnings.clone();
-    Ok(scene)
+    result
 }
 
 fn invalid_gltf(path: &Path, e: impl std::fmt::Display) -> anyhow::Error {
@@ -172,6 +189,17 @@ fn invalid_gltf(path: &Path, e: impl std::fmt::Display) -> anyhow::Error {
 
 /// Validates the JSON into a document. A primitive whose POSITION accessor does not exist makes
 /// gltf-json's validation index out of bounds (found by fuzzing), so it is checked first.
+/// The document without its buffers' URIs, which are read: a data URI holds the whole buffer in
+/// base64, a third larger than the decoded data.
+fn without_buffer_uris(document: gltf::Document) -> gltf::Document {
+    let mut root = document.into_json();
+    for buffer in &mut root.buffers {
+        buffer.uri = None;
+    }
+    // Validated when parsed; dropping URIs leaves it valid.
+    gltf::Document::from_json_without_validation(root)
+}
+
 fn parse_gltf(json: serde_json::Value, path: &Path) -> Result<gltf::Document> {
     use gltf::json::{mesh::Semantic, validation::Checked};
     let root: gltf::json::Root = serde_json::from_value(json).map_err(|e| invalid_gltf(path, e))?;
@@ -224,7 +252,7 @@ impl<'a> Loader<'a> {
         self.warnings.push(format!("{}: {msg}", self.path.display()));
     }
 
-    fn run(&mut self, options: &LoadOptions) -> Result<Scene> {
+    fn run(&mut self, options: &LoadOptions) -> Result<LoadedParts> {
         self.load_materials()?;
         let doc = self.doc;
         let scene = match options.scene {
@@ -338,7 +366,7 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>, textures: SceneTextures) -> Result<Scene> {
+    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>, textures: SceneTextures) -> Result<LoadedParts> {
         let this = self;
         let skipped_bounds = this.counts.skipped_bounds;
         // Flat faces without textures need no attributes: their kernels do without.
@@ -381,8 +409,7 @@ impl<'a> Loader<'a> {
             ));
             this.cameras.push(camera);
         }
-        let origin = this.origin;
-        let mut scene = Scene::build(SceneParts {
+        let parts = SceneParts {
             source: this.path.to_path_buf(),
             triangles: std::mem::take(&mut this.triangles),
             surfaces,
@@ -394,9 +421,8 @@ impl<'a> Loader<'a> {
             cameras: std::mem::take(&mut this.cameras),
             lights: std::mem::take(&mut this.lights),
             warnings: Vec::new(),
-        });
-        scene.origin = origin;
-        Ok(scene)
+        };
+        Ok((parts, this.origin))
     }
 
     /// One warning per kind of thing dropped, with its count over the whole file.

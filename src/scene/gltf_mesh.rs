@@ -237,10 +237,25 @@ impl Loader<'_> {
         Ok(())
     }
 
-    /// The spec's accessor types for positions (float VEC3) and indices (unsigned SCALAR); the
-    /// gltf crate's readers assume them (an index accessor of floats hits `unreachable!`).
+    /// The spec's accessor counts (at least 1) and types for positions (float VEC3), indices
+    /// (unsigned SCALAR) and colours; the gltf crate's readers assume them (an index accessor of
+    /// floats hits `unreachable!`, a count of 0 overflows).
     fn check_accessor_types(&self, mesh: &gltf::Mesh, prim: &gltf::Primitive) -> Result<()> {
         use gltf::accessor::{DataType, Dimensions};
+        // glTF requires count >= 1, and the readers compute count - 1 (an overflow at 0).
+        let read = [
+            ("POSITION", prim.get(&gltf::Semantic::Positions)),
+            ("indices", prim.indices()),
+            ("COLOR_0", prim.get(&gltf::Semantic::Colors(0))),
+        ];
+        for (name, accessor) in read {
+            if accessor.is_some_and(|a| a.count() == 0) {
+                bail!(problem(
+                    self.path,
+                    format!("mesh {}: the {name} accessor has count 0", mesh.index())
+                ));
+            }
+        }
         if let Some(p) = prim.get(&gltf::Semantic::Positions) {
             if p.data_type() != DataType::F32 || p.dimensions() != Dimensions::Vec3 {
                 bail!(problem(

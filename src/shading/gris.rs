@@ -126,6 +126,13 @@ pub fn resampled_expectation<S: Copy>(domains: &impl Domains<S>, inputs: &[Input
         .sum()
 }
 
+/// The target function p̂ of a path: the luminance of its contribution f (RGB). Every channel
+/// has a positive weight, so p̂ > 0 wherever f is non-zero, as unbiased resampling requires.
+/// Twin of `target_function` in glsl/reservoir.glsl.
+pub fn target_function(contribution: Vec3) -> f32 {
+    contribution.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 /// Streaming weighted selection, candidate by candidate, as the kernels resample: after
 /// `resampler_offer` of candidates with weights w_i, candidate i is chosen with probability
 /// w_i / sum_j w_j, and `resampler_finish` gives W = sum_j w_j / p̂(chosen). `expected` is

@@ -4,6 +4,7 @@
 //! the reuse estimator the ReSTIR passes implement.
 
 pub mod bsdf;
+pub mod candidates;
 pub mod gris;
 pub mod lights;
 pub mod path_record;

@@ -1,5 +1,5 @@
-//! A compute pipeline with descriptor sets of buffers (set 0, and optionally set 1) and an
-//! optional push-constant block.
+//! A compute pipeline with descriptor sets of buffers (set 0, and set 1 for the scene's surface
+//! attributes and textures), bound by name, and an optional push-constant block.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 use ash::vk;
 
+use super::reflect::check_bindings;
 use super::{compile_kernel, Buffer, Context};
 use crate::error::{vk_error, GpuError};
 
@@ -14,6 +15,40 @@ use crate::error::{vk_error, GpuError};
 pub enum Binding {
     Uniform,
     Storage,
+}
+
+/// One binding of a kernel: its descriptor set and number, the GLSL block declared there and
+/// its descriptor kind. src/shader_interface.rs declares those of the renderers' kernels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BindingSlot {
+    pub set: u32,
+    pub binding: u32,
+    pub block: &'static str,
+    pub kind: Binding,
+}
+
+impl BindingSlot {
+    /// A storage-buffer binding of set 0.
+    pub fn storage(binding: u32, block: &'static str) -> Self {
+        Self {
+            set: 0,
+            binding,
+            block,
+            kind: Binding::Storage,
+        }
+    }
+
+    /// `buffer` bound to this binding.
+    pub fn to(self, buffer: &Buffer) -> BoundBuffer<'_> {
+        BoundBuffer { slot: self, buffer }
+    }
+}
+
+/// A buffer for the binding `slot` (checked against the kernel's layout by `Kernel::bind`).
+#[derive(Clone, Copy)]
+pub struct BoundBuffer<'a> {
+    pub slot: BindingSlot,
+    pub buffer: &'a Buffer,
 }
 
 impl Binding {
@@ -50,11 +85,13 @@ impl KernelCompile {
 pub struct Kernel {
     pub name: String,
     compile: KernelCompile,
-    /// The bindings of each descriptor set, set 0 first.
-    bindings: Vec<Vec<Binding>>,
+    /// The bindings of every set.
+    bindings: Vec<BindingSlot>,
     push_bytes: u32,
     pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
+    /// One layout and one descriptor set per set number up to the highest the bindings use (a
+    /// set without bindings still gets its empty layout, so that later sets keep their numbers).
     set_layouts: Vec<vk::DescriptorSetLayout>,
     pool: vk::DescriptorPool,
     sets: Vec<vk::DescriptorSet>,
@@ -63,20 +100,16 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// Builds the kernel glsl/`name` whose set 0 has `bindings` at indices 0..n.
-    pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], bindings: &[Binding], push_bytes: u32) -> Result<Self> {
-        Self::with_sets(ctx, name, defines, &[bindings], push_bytes)
-    }
-
-    /// Builds the kernel glsl/`name` whose set k has `sets[k]` at indices 0..n (an empty set
-    /// still gets its layout, so that later sets keep their numbers).
-    pub fn with_sets(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], sets: &[&[Binding]], push_bytes: u32) -> Result<Self> {
+    /// Builds the kernel glsl/`name` with the bindings `layout` (of any sets). Fails when the
+    /// compiled shader declares a binding that `layout` lacks or names differently.
+    pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], layout: &[BindingSlot], push_bytes: u32) -> Result<Self> {
         let start = Instant::now();
         let spirv = compile_kernel(name, defines)?;
         let glsl_ms = start.elapsed().as_secs_f64() * 1e3;
+        check_bindings(name, &spirv, layout).map_err(anyhow::Error::msg)?;
         let start = Instant::now();
         let mut kernel =
-            Self::from_spirv(ctx, name, &spirv, sets, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
+            Self::from_spirv(ctx, name, &spirv, layout, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
         kernel.compile = KernelCompile {
             name: name.to_string(),
             spirv_bytes: spirv.len() * 4,
@@ -108,13 +141,13 @@ impl Kernel {
         Ok(())
     }
 
-    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], sets: &[&[Binding]], push_bytes: u32) -> Result<Self, GpuError> {
+    fn from_spirv(ctx: &Arc<Context>, name: &str, spirv: &[u32], bindings: &[BindingSlot], push_bytes: u32) -> Result<Self, GpuError> {
         let device = &ctx.device;
         // Each handle is owned by `kernel` as soon as it exists, so an early return frees it.
         let mut kernel = Kernel {
             name: name.to_string(),
             compile: KernelCompile::default(),
-            bindings: sets.iter().map(|b| b.to_vec()).collect(),
+            bindings: bindings.to_vec(),
             push_bytes,
             pipeline: vk::Pipeline::null(),
             layout: vk::PipelineLayout::null(),
@@ -126,14 +159,15 @@ impl Kernel {
         };
         let module_info = vk::ShaderModuleCreateInfo::default().code(spirv);
         kernel.module = unsafe { device.create_shader_module(&module_info, None) }.map_err(vk_error("creating a shader module"))?;
-        for bindings in sets {
+        let set_count = bindings.iter().map(|b| b.set + 1).max().unwrap_or(1);
+        for set in 0..set_count {
             let layout_bindings: Vec<_> = bindings
                 .iter()
-                .enumerate()
-                .map(|(i, b)| {
+                .filter(|b| b.set == set)
+                .map(|b| {
                     vk::DescriptorSetLayoutBinding::default()
-                        .binding(i as u32)
-                        .descriptor_type(b.descriptor_type())
+                        .binding(b.binding)
+                        .descriptor_type(b.kind.descriptor_type())
                         .descriptor_count(1)
                         .stage_flags(vk::ShaderStageFlags::COMPUTE)
                 })
@@ -163,14 +197,12 @@ impl Kernel {
 
         let mut sizes = Vec::new();
         for kind in [Binding::Uniform, Binding::Storage] {
-            let count = sets.iter().flat_map(|b| b.iter()).filter(|&&b| b == kind).count() as u32;
+            let count = bindings.iter().filter(|b| b.kind == kind).count() as u32;
             if count > 0 {
                 sizes.push(vk::DescriptorPoolSize::default().ty(kind.descriptor_type()).descriptor_count(count));
             }
         }
-        let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(sets.len() as u32)
-            .pool_sizes(&sizes);
+        let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(set_count).pool_sizes(&sizes);
         kernel.pool = unsafe { device.create_descriptor_pool(&pool_info, None) }.map_err(vk_error("creating a descriptor pool"))?;
         let alloc_info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(kernel.pool)
@@ -179,37 +211,70 @@ impl Kernel {
         Ok(kernel)
     }
 
-    /// Points binding i of set 0 at `buffers[i]`; the caller keeps the buffers alive while
-    /// dispatching.
-    pub fn bind(&self, buffers: &[&Buffer]) {
-        self.bind_set(0, buffers);
-    }
-
-    /// Points binding i of set `set` at `buffers[i]`.
-    pub fn bind_set(&self, set: usize, buffers: &[&Buffer]) {
-        assert_eq!(
-            buffers.len(),
-            self.bindings[set].len(),
-            "kernel {} takes {} bindings in set {set}",
-            self.name,
-            self.bindings[set].len()
-        );
+    /// Points each binding of the layout at its buffer in `buffers`, matched by set and number
+    /// and checked by block name and kind; every binding of each set that `buffers` touches
+    /// must be given exactly once (sets are bound separately: a scene's set 1 once at build,
+    /// set 0 by the renderer). The caller keeps the buffers alive while dispatching.
+    pub fn bind(&self, buffers: &[BoundBuffer]) -> Result<()> {
+        let same = |a: &BindingSlot, b: &BindingSlot| a.set == b.set && a.binding == b.binding;
+        for (i, bound) in buffers.iter().enumerate() {
+            let slot = bound.slot;
+            if !self.bindings.contains(&slot) {
+                anyhow::bail!(
+                    "kernel {}: its layout has no binding {} {} ({:?}) in set {}",
+                    self.name,
+                    slot.binding,
+                    slot.block,
+                    slot.kind,
+                    slot.set
+                );
+            }
+            if buffers[..i].iter().any(|b| same(&b.slot, &slot)) {
+                anyhow::bail!(
+                    "kernel {}: binding {} ({}) of set {} given twice",
+                    self.name,
+                    slot.binding,
+                    slot.block,
+                    slot.set
+                );
+            }
+        }
+        if let Some(missing) = self
+            .bindings
+            .iter()
+            .filter(|s| buffers.iter().any(|b| b.slot.set == s.set))
+            .find(|s| !buffers.iter().any(|b| same(&b.slot, s)))
+        {
+            anyhow::bail!(
+                "kernel {}: no buffer for binding {} ({}) of set {}",
+                self.name,
+                missing.binding,
+                missing.block,
+                missing.set
+            );
+        }
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
-            .map(|b| [vk::DescriptorBufferInfo::default().buffer(b.handle).offset(0).range(vk::WHOLE_SIZE)])
+            .map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(b.buffer.handle)
+                    .offset(0)
+                    .range(vk::WHOLE_SIZE)]
+            })
             .collect();
         let writes: Vec<_> = infos
             .iter()
-            .enumerate()
-            .map(|(i, info)| {
+            .zip(buffers)
+            .map(|(info, bound)| {
                 vk::WriteDescriptorSet::default()
-                    .dst_set(self.sets[set])
-                    .dst_binding(i as u32)
-                    .descriptor_type(self.bindings[set][i].descriptor_type())
+                    .dst_set(self.sets[bound.slot.set as usize])
+                    .dst_binding(bound.slot.binding)
+                    .descriptor_type(bound.slot.kind.descriptor_type())
                     .buffer_info(info)
             })
             .collect();
         unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };
+        Ok(())
     }
 
     /// Records a dispatch of `groups` workgroups with `push` as the push-constant block.
@@ -257,6 +322,24 @@ pub fn record_compute_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
     };
 }
 
+/// Makes transfer writes visible to the host once the submission's fence has signalled.
+pub fn record_host_read_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::HOST_READ)];
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::HOST,
+            vk::DependencyFlags::empty(),
+            &barrier,
+            &[],
+            &[],
+        )
+    };
+}
+
 impl Drop for Kernel {
     fn drop(&mut self) {
         let device = &self.ctx.device;
@@ -264,8 +347,8 @@ impl Drop for Kernel {
             device.destroy_pipeline(self.pipeline, None);
             device.destroy_pipeline_layout(self.layout, None);
             device.destroy_descriptor_pool(self.pool, None);
-            for &layout in &self.set_layouts {
-                device.destroy_descriptor_set_layout(layout, None);
+            for &set_layout in &self.set_layouts {
+                device.destroy_descriptor_set_layout(set_layout, None);
             }
             device.destroy_shader_module(self.module, None);
         }

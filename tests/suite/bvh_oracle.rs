@@ -9,7 +9,7 @@ use restir_pt::scene::gltf_writer::MeshData;
 use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
 use restir_pt::shading::lights::sample_light;
 use restir_pt::shading::ray_offset::offset_ray_origin;
-use restir_pt::vk::{Buffer, BufferUsage};
+use restir_pt::vk::{BindingSlot, Buffer, BufferUsage};
 
 use crate::common::{assert_clean, close, gpu, run_oracle_with_defines, TestRng};
 
@@ -178,7 +178,7 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         "oracle/scene_oracle.comp",
         defines,
         &scene_gpu.buffers(&params),
-        &[bytemuck::cast_slice(&inputs)],
+        &[("Inputs", bytemuck::cast_slice(&inputs))],
         RAYS * 24,
         RAYS as u32,
     );
@@ -326,13 +326,15 @@ fn environment_map_light_sampling_glsl_matches_rust() {
     let output = Buffer::new(&ctx, "outputs", (RAYS * 24 * 4) as u64, BufferUsage::Storage).unwrap();
     output.fill(crate::common::NAN_FILL).unwrap();
     let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend([&input, &output]);
-    let mut kinds = scene_gpu.bindings();
-    kinds.extend([restir_pt::vk::Binding::Storage, restir_pt::vk::Binding::Storage]);
+    buffers.extend([
+        BindingSlot::storage(5, "Inputs").to(&input),
+        BindingSlot::storage(6, "Outputs").to(&output),
+    ]);
+    let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
     let defines = scene_gpu.defines();
     assert!(defines.contains(&("SCENE_ENV_MAP", "1")));
-    let kernel = restir_pt::vk::Kernel::new(&ctx, "oracle/scene_oracle.comp", &defines, &kinds, 4).unwrap();
-    kernel.bind(&buffers);
+    let kernel = restir_pt::vk::Kernel::new(&ctx, "oracle/scene_oracle.comp", &defines, &layout, 4).unwrap();
+    kernel.bind(&buffers).unwrap();
     kernel.run_1d(RAYS as u32, 64, bytemuck::bytes_of(&(RAYS as u32))).unwrap();
     let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(RAYS * 24).unwrap()).to_vec();
     let (mut env_samples, mut near_edges) = (0, 0);

@@ -5,7 +5,7 @@ use std::process::Command;
 
 use crate::common::{repo_path, temp_file};
 
-fn restir_pt(args: &[&str]) -> (i32, String, String) {
+pub(crate) fn restir_pt(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_restir-pt"))
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -19,7 +19,7 @@ fn restir_pt(args: &[&str]) -> (i32, String, String) {
 }
 
 /// Exit code 1 and exactly one `error:` line that mentions every `needle`.
-fn assert_clean_failure(args: &[&str], needles: &[&str]) {
+pub(crate) fn assert_clean_failure(args: &[&str], needles: &[&str]) {
     let (code, _, stderr) = restir_pt(args);
     assert_eq!(code, 1, "{args:?} should fail; stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");

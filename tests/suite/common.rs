@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use restir_pt::vk::{Binding, Buffer, Context, ContextOptions, Kernel};
+use restir_pt::vk::{BindingSlot, BoundBuffer, Buffer, Context, ContextOptions, Kernel};
 
 /// NaN bits pre-filled into every output buffer, so that an unwritten slot fails a comparison.
 pub const NAN_FILL: u32 = 0x7fc0_0000;
@@ -35,13 +35,24 @@ pub fn repo_path(relative: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
 }
 
-/// Runs an oracle kernel over `count` items: `inputs` go to the first bindings, then one output
-/// buffer of `output_words` 32-bit words pre-filled with NaN, which is returned.
+/// The scene's bindings as storage buffers, as oracle kernels compiled without the scene's
+/// defines (SCENE_UNIFORM_BUFFERS unset) declare them.
+pub fn as_storage(bound: Vec<BoundBuffer>) -> Vec<BoundBuffer> {
+    bound
+        .into_iter()
+        .map(|b| BindingSlot::storage(b.slot.binding, b.slot.block).to(b.buffer))
+        .collect()
+}
+
+/// Runs an oracle kernel over `count` items. The `leading` buffers keep their bindings; the
+/// storage blocks named in `inputs` follow them in order, then the block `Outputs` of
+/// `output_words` 32-bit words pre-filled with NaN, which is returned. Kernel::new checks each
+/// name against the block the kernel declares at that binding.
 pub fn run_oracle<T: bytemuck::Pod>(
     ctx: &Arc<Context>,
     kernel: &str,
-    leading: &[&Buffer],
-    inputs: &[&[u8]],
+    leading: &[BoundBuffer],
+    inputs: &[(&'static str, &[u8])],
     output_words: usize,
     count: u32,
 ) -> Vec<T> {
@@ -53,24 +64,26 @@ pub fn run_oracle_with_defines<T: bytemuck::Pod>(
     ctx: &Arc<Context>,
     kernel: &str,
     defines: &[(&str, &str)],
-    leading: &[&Buffer],
-    inputs: &[&[u8]],
+    leading: &[BoundBuffer],
+    inputs: &[(&'static str, &[u8])],
     output_words: usize,
     count: u32,
 ) -> Vec<T> {
     let input_buffers: Vec<Buffer> = inputs
         .iter()
-        .enumerate()
-        .map(|(i, data)| Buffer::from_slice(ctx, &format!("oracle input {i}"), data).unwrap())
+        .map(|(name, data)| Buffer::from_slice(ctx, name, data).unwrap())
         .collect();
     let output = Buffer::new(ctx, "oracle output", output_words as u64 * 4, restir_pt::vk::BufferUsage::Storage).unwrap();
     output.fill(NAN_FILL).unwrap();
-    let mut bindings: Vec<&Buffer> = leading.to_vec();
-    bindings.extend(input_buffers.iter());
-    bindings.push(&output);
-    let kinds = vec![Binding::Storage; bindings.len()];
-    let k = Kernel::new(ctx, kernel, defines, &kinds, 4).unwrap();
-    k.bind(&bindings);
+    let first = leading.len() as u32;
+    let mut bindings: Vec<BoundBuffer> = leading.to_vec();
+    for (i, ((name, _), buffer)) in inputs.iter().zip(&input_buffers).enumerate() {
+        bindings.push(BindingSlot::storage(first + i as u32, name).to(buffer));
+    }
+    bindings.push(BindingSlot::storage(first + inputs.len() as u32, "Outputs").to(&output));
+    let layout: Vec<BindingSlot> = bindings.iter().map(|b| b.slot).collect();
+    let k = Kernel::new(ctx, kernel, defines, &layout, 4).unwrap();
+    k.bind(&bindings).unwrap();
     k.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
     let words = output.read::<u32>(output_words).unwrap();
     bytemuck::cast_slice(&words).to_vec()

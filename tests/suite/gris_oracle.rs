@@ -6,6 +6,7 @@
 //! offered candidates with zero weights and lost choices, as the reuse passes see them.
 
 use glam::{Vec3, Vec4};
+use restir_pt::render::ReuseMis;
 use restir_pt::shading::gris::{mis_weight, resampler_begin, resampler_finish, resampler_offer, Domains, Input, Mis};
 
 use crate::common::{close, gpu, run_oracle_with_defines, TestRng};
@@ -104,17 +105,22 @@ fn run_glsl(cases: &[Case], mis: Mis) -> Vec<Vec4> {
         .flat_map(|c| c.offers)
         .flat_map(|o| [o.contribution.extend(o.target), Vec4::new(o.weight, o.u, o.lost as u32 as f32, 0.0)])
         .collect();
-    let mode = if mis == Mis::Pairwise { "1" } else { "0" };
+    let mode = if mis == Mis::Pairwise {
+        ReuseMis::Pairwise
+    } else {
+        ReuseMis::GeneralizedBalance
+    }
+    .glsl_name();
     let out = run_oracle_with_defines(
         &ctx,
         "oracle/gris_oracle.comp",
         &[("MIS_MODE", mode)],
         &[],
         &[
-            bytemuck::cast_slice(&counts),
-            bytemuck::cast_slice(&confidences),
-            bytemuck::cast_slice(&targets),
-            bytemuck::cast_slice(&offers),
+            ("Counts", bytemuck::cast_slice(&counts)),
+            ("Confidences", bytemuck::cast_slice(&confidences)),
+            ("Targets", bytemuck::cast_slice(&targets)),
+            ("Offers", bytemuck::cast_slice(&offers)),
         ],
         cases.len() * 16,
         cases.len() as u32,

@@ -1,14 +1,18 @@
 //! Host structs against the GLSL layout: member offsets and array strides read from the SPIR-V
 //! that glslang produced (OpMemberDecorate Offset, OpDecorate ArrayStride) must equal the
-//! `#[repr(C)]` offsets and sizes of the Rust twins in src/gpu_types.rs.
+//! `#[repr(C)]` offsets and sizes of the Rust twins in src/gpu_types.rs; and every kernel's
+//! descriptor bindings (number, block name, descriptor type) must be those that
+//! src/shader_interface.rs declares.
 
 use std::collections::HashMap;
 
 use restir_pt::gpu_types::{
     BvhNode, Emitter, FrameParams, Material, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface, Triangle,
 };
+use restir_pt::render::{PassKernel, ReuseMis, ShiftKind};
+use restir_pt::shader_interface::{PathTraceBinding, RestirBinding, SceneBinding, SurfaceBinding};
 use restir_pt::shading::path_record::PathRecord;
-use restir_pt::vk::compile_kernel;
+use restir_pt::vk::{check_bindings, compile_kernel, reflect_bindings, Binding, BindingSlot};
 
 const OP_NAME: u32 = 5;
 const OP_MEMBER_NAME: u32 = 6;
@@ -71,7 +75,7 @@ type StructLayout = (&'static str, usize, Vec<(String, u32)>);
 
 fn scene_structs() -> Vec<StructLayout> {
     vec![
-        rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, pad),
+        rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, specular, specular_color, pad),
         rust_fields!(Triangle: v0, material, e1, emitter, e2, pad),
         rust_fields!(BvhNode: lo, skip, hi, leaf),
         rust_fields!(Emitter: triangle, select_pdf, alias_prob, alias),
@@ -129,7 +133,7 @@ fn path_record_matches_glsl_layout() {
         rust_fields!(PathRecord: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry, suffix,
         rc_pdf_after, contribution, rc_next_triangle),
     ];
-    assert_eq!(check_layout("oracle/shift_oracle.comp", &[], record), 1);
+    assert_eq!(check_layout("oracle/shift_oracle.comp", &[("ORACLE_SHIFT", "0")], record), 1);
 }
 
 #[test]
@@ -147,4 +151,146 @@ fn restir_structs_match_glsl_layout() {
     ];
     assert_eq!(check_layout("restir_spatial.comp", &[], structs), 6);
     assert_eq!(std::mem::size_of::<ReservoirHead>() + std::mem::size_of::<ReservoirTail>(), 96);
+}
+
+/// The uniform-buffer variant's defines, with small array sizes.
+const UNIFORM_SCENE: [(&str, &str); 5] = [
+    ("SCENE_UNIFORM_BUFFERS", "1"),
+    ("SCENE_TRIANGLE_COUNT", "4"),
+    ("SCENE_NODE_COUNT", "3"),
+    ("SCENE_MATERIAL_COUNT", "2"),
+    ("SCENE_EMITTER_SLOTS", "1"),
+];
+
+/// The host layout of a scene kernel: bindings 0-4 (the scene arrays as `scene`), then `own`.
+fn host_layout(scene: Binding, own: impl Iterator<Item = BindingSlot>) -> Vec<BindingSlot> {
+    let scene_slots = SceneBinding::ALL.iter().map(|&b| {
+        let kind = if b == SceneBinding::FrameParams { Binding::Storage } else { scene };
+        b.slot(kind)
+    });
+    scene_slots.chain(own).collect()
+}
+
+/// Every binding a kernel's SPIR-V declares, as (number, block, kind), must be the host's of
+/// that number (the compiler drops blocks a kernel never reads). Returns the numbers found.
+fn assert_bindings(kernel: &str, defines: &[(&str, &str)], layout: &[BindingSlot]) -> Vec<u32> {
+    let spirv = compile_kernel(kernel, defines).expect("kernel compiles");
+    let found = reflect_bindings(&spirv);
+    for b in &found {
+        assert_eq!(b.set, 0, "{kernel}: {} in set {}", b.block, b.set);
+        let host = layout.iter().find(|s| s.binding == b.binding);
+        assert_eq!(
+            host.map(|s| (s.block, s.kind)),
+            Some((b.block.as_str(), b.kind)),
+            "{kernel} {defines:?}: binding {} in src/shader_interface.rs (left) vs SPIR-V (right)",
+            b.binding
+        );
+    }
+    check_bindings(kernel, &spirv, layout).expect("the start-up check agrees");
+    found.iter().map(|b| b.binding).collect()
+}
+
+#[test]
+fn every_kernel_declares_the_bindings_of_the_shader_interface() {
+    let restir = || RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let pathtrace = || PathTraceBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    for (scene, defines) in [(Binding::Storage, &[][..]), (Binding::Uniform, &UNIFORM_SCENE[..])] {
+        let layout = host_layout(scene, pathtrace());
+        let found = assert_bindings("pathtrace.comp", defines, &layout);
+        assert_eq!(found, (0..8).collect::<Vec<u32>>(), "pathtrace.comp reads every binding");
+        let layout = host_layout(scene, restir());
+        let mut used = vec![false; layout.len()];
+        // Every kernel with the default shift and MIS, and the reuse kernels with the others
+        // (each variant is a glslang compile of seconds, so not every product).
+        let mut variants: Vec<(PassKernel, ShiftKind, ReuseMis)> = PassKernel::ALL
+            .iter()
+            .map(|&k| (k, ShiftKind::Hybrid, ReuseMis::GeneralizedBalance))
+            .collect();
+        if scene == Binding::Storage {
+            variants.extend([
+                (PassKernel::Spatial, ShiftKind::Reconnection, ReuseMis::Pairwise),
+                (PassKernel::Temporal, ShiftKind::Replay, ReuseMis::Pairwise),
+            ]);
+        }
+        for (kernel, shift, mis) in variants {
+            let (file, extra) = kernel.source();
+            let mut all: Vec<(&str, &str)> = defines.iter().chain(extra).copied().collect();
+            all.extend([("SHIFT_MODE", shift.glsl_name()), ("MIS_MODE", mis.glsl_name())]);
+            for b in assert_bindings(file, &all, &layout) {
+                used[b as usize] = true;
+            }
+        }
+        // Each binding is checked against a kernel that declares it.
+        assert!(used.iter().all(|&u| u), "bindings no ReSTIR kernel declares: {used:?}");
+    }
+}
+
+/// A textured scene's kernels declare descriptor set 1 as SurfaceBinding numbers it, and the
+/// start-up check covers that set: two of its blocks swapped, or the set left out of the host
+/// layout, are refused.
+#[test]
+fn textured_scene_kernels_declare_the_surface_set() {
+    let textured = [("SCENE_SURFACE", "1"), ("SCENE_TEXTURES", "1")];
+    let surface = || SurfaceBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let expected: Vec<(u32, u32, String)> = SurfaceBinding::ALL
+        .iter()
+        .map(|b| (1, b.binding(), b.block().to_string()))
+        .collect();
+    let restir = || RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let pathtrace = || PathTraceBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let (spatial, _) = PassKernel::Spatial.source();
+    for (kernel, own) in [
+        ("pathtrace.comp", pathtrace().collect::<Vec<_>>()),
+        (spatial, restir().collect::<Vec<_>>()),
+    ] {
+        let spirv = compile_kernel(kernel, &textured).expect("kernel compiles");
+        let set1: Vec<(u32, u32, String)> = reflect_bindings(&spirv)
+            .into_iter()
+            .filter(|b| b.set != 0)
+            .map(|b| (b.set, b.binding, b.block))
+            .collect();
+        assert_eq!(set1, expected, "{kernel}: set 1 in the SPIR-V");
+        let layout = host_layout(Binding::Storage, own.iter().copied().chain(surface()));
+        check_bindings(kernel, &spirv, &layout).expect("the shader interface's own layout");
+
+        let mut swapped = layout.clone();
+        let at = |block: &str| swapped.iter().position(|s| s.set == 1 && s.block == block).expect("in the layout");
+        let (headers, texels) = (at("TextureHeaders"), at("Texels"));
+        swapped[headers].block = "Texels";
+        swapped[texels].block = "TextureHeaders";
+        let error = check_bindings(kernel, &spirv, &swapped).expect_err("swapped names are refused");
+        assert!(
+            error.contains("binding 2 is TextureHeaders") && error.contains("(set 1)"),
+            "{error}"
+        );
+
+        let set0_only = host_layout(Binding::Storage, own.iter().copied());
+        let error = check_bindings(kernel, &spirv, &set0_only).expect_err("set 1 missing from the host layout");
+        assert!(error.contains("binding 0 (SurfaceAttributes) of set 1"), "{error}");
+    }
+}
+
+#[test]
+fn a_host_layout_with_two_buffers_swapped_is_refused() {
+    let spirv = compile_kernel("restir_spatial.comp", &[]).expect("kernel compiles");
+    let mut layout = host_layout(Binding::Storage, RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
+    check_bindings("restir_spatial.comp", &spirv, &layout).expect("the shader interface's own layout");
+    let (heads0, heads1) = (
+        RestirBinding::ReservoirHeads0.binding() as usize,
+        RestirBinding::ReservoirHeads1.binding() as usize,
+    );
+    let (a, b) = (layout[heads0].block, layout[heads1].block);
+    layout[heads0].block = b;
+    layout[heads1].block = a;
+    let error = check_bindings("restir_spatial.comp", &spirv, &layout).expect_err("swapped names are refused");
+    assert!(
+        error.contains("binding 8 is ReservoirHeads0") && error.contains("ReservoirHeads1"),
+        "{error}"
+    );
+    let mut uniform = host_layout(Binding::Uniform, RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
+    let error = check_bindings("restir_spatial.comp", &spirv, &uniform).expect_err("a uniform scene against storage blocks");
+    assert!(error.contains("binding 1 is Triangles (Storage)"), "{error}");
+    uniform.truncate(18);
+    let error = check_bindings("restir_spatial.comp", &spirv, &uniform[..]).expect_err("a missing binding");
+    assert!(error.contains("binding 1") || error.contains("binding 18"), "{error}");
 }

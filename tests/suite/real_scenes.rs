@@ -464,6 +464,26 @@ fn real_scenes_env_file_loads_exr_and_hdr_and_renders_with_both_methods() {
     let (code, _, stderr) = restir_pt(&["render", scene.to_str().unwrap(), "--env", bad.to_str().unwrap()]);
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("R,G,B") && stderr.contains("FILE.exr|FILE.hdr"), "{stderr}");
+    // Negative values reach the radiance check (not clap's "unexpected argument"); each odd value
+    // gets one error line that names it and its problem.
+    for (value, problem) in [
+        ("-1,0,0", "-1 is negative"),
+        ("1,-0.5,0", "-0.5 is negative"),
+        ("1,2", "has 2 value(s)"),
+        ("a,b,c", "\"a\" is not a number"),
+        ("nan,0,0", "not a finite"),
+        ("1e40,0,0", "not a finite"),
+        ("", "empty"),
+    ] {
+        let (code, _, stderr) = restir_pt(&["render", scene.to_str().unwrap(), "--env", value]);
+        assert_eq!(code, 2, "--env {value:?}: {stderr}");
+        let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+        assert_eq!(errors.len(), 1, "--env {value:?}: {stderr}");
+        assert!(
+            errors[0].contains(problem) && errors[0].contains("--env takes R,G,B"),
+            "--env {value:?}: {stderr}"
+        );
+    }
     for method in [["--method", "pt", "--spp", "8"].as_slice(), &["--method", "restir"]] {
         let out = dir.join("env-render.exr");
         let mut args = vec![

@@ -20,7 +20,7 @@ fn rng_pcg4d_path_seed_rng_uniform4_glsl_matches_rust_bit_exact() {
         &ctx,
         "oracle/rng_oracle.comp",
         &[],
-        &[bytemuck::cast_slice(&keys)],
+        &[("Inputs", bytemuck::cast_slice(&keys))],
         n * 12,
         n as u32,
     );

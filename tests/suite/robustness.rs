@@ -112,12 +112,13 @@ fn robustness_bad_input_corpus_gives_clear_errors_or_warnings() {
     }
 }
 
-/// Every file in the fuzz corpus (and the bad-input corpus) goes through the loader without a
-/// panic: an error is fine, a crash is not.
+/// Every file in the fuzz corpus, the inputs that once crashed the loader (fuzz/regressions),
+/// the bad-input corpus and the bundled scenes goes through the loader without a panic: an error
+/// is fine, a crash is not.
 #[test]
 fn robustness_fuzz_corpus_replays_without_panic() {
     let mut count = 0;
-    for dir in ["fuzz/corpus/load_scene", "tests/data/bad", "scenes"] {
+    for dir in ["fuzz/corpus/load_scene", "fuzz/regressions/load_scene", "tests/data/bad", "scenes"] {
         for entry in std::fs::read_dir(repo_path(dir)).unwrap() {
             let path = entry.unwrap().path();
             let bytes = std::fs::read(&path).unwrap();
@@ -126,6 +127,15 @@ fn robustness_fuzz_corpus_replays_without_panic() {
         }
     }
     assert!(count >= 40, "only {count} corpus files");
+    // Each of these once panicked the loader; each is malformed and must now be refused.
+    let mut regressions = 0;
+    for entry in std::fs::read_dir(repo_path("fuzz/regressions/load_scene")).unwrap() {
+        let path = entry.unwrap().path();
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(load_scene_from_bytes(&bytes, None, &path).is_err(), "{}: loaded", path.display());
+        regressions += 1;
+    }
+    assert!(regressions >= 4, "only {regressions} crash regressions");
 }
 
 fn render_at(width: u32, height: u32) -> anyhow::Result<restir_pt::render::Image> {

@@ -23,7 +23,7 @@ fn sampling_glsl_matches_rust() {
         &ctx,
         "oracle/sampling_oracle.comp",
         &[],
-        &[bytemuck::cast_slice(&inputs)],
+        &[("Inputs", bytemuck::cast_slice(&inputs))],
         n * 7 * 4,
         n as u32,
     );

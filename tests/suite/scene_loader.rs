@@ -133,20 +133,31 @@ fn loader_reads_environment_and_rejects_bad_values() {
 
 #[test]
 fn loader_warns_about_textures_and_rejects_unsupported_required_extensions() {
+    // A texture the renderer does not read is reported and its image never opened (it is
+    // missing here); one it reads (base colour, docs/textures.md) must decode.
     let path = scene_file("texture.gltf", floor(), Some(lamp()), |v| {
         v["images"] = json!([{ "uri": "missing.png" }]);
         v["textures"] = json!([{ "source": 0 }]);
-        v["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+        v["extensionsUsed"] = json!(["KHR_materials_transmission"]);
+        v["materials"][0]["extensions"] =
+            json!({ "KHR_materials_transmission": { "transmissionFactor": 0.5, "transmissionTexture": { "index": 0 } } });
     });
     let scene = load_scene(&path).unwrap();
     assert!(
         scene
             .warnings
             .iter()
-            .any(|w| w.contains("texture.gltf") && w.contains("base colour texture ignored")),
+            .any(|w| w.contains("texture.gltf") && w.contains("transmission texture ignored")),
         "{:?}",
         scene.warnings
     );
+    let path = scene_file("missing-image.gltf", floor(), Some(lamp()), |v| {
+        v["images"] = json!([{ "uri": "missing.png" }]);
+        v["textures"] = json!([{ "source": 0 }]);
+        v["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+    });
+    let e = load_error(&path);
+    assert!(e.contains("missing-image.gltf") && e.contains("image 0: cannot decode"), "{e}");
     let path = scene_file("required.gltf", floor(), Some(lamp()), |v| {
         v["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
         v["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
@@ -283,4 +294,28 @@ fn loader_recentres_a_scene_without_camera_on_its_bounds_centre_in_f64() {
         v
     };
     assert_eq!(bits(&far_scene), bits(&near));
+}
+
+#[test]
+fn loader_names_a_file_that_is_not_gltf_in_one_line() {
+    let png = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR";
+    for (name, bytes) in [
+        ("notes.gltf", b"hello world\n".as_slice()),
+        ("model.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"),
+        ("picture.png", png),
+    ] {
+        let e = load_error(&temp_file(name, bytes));
+        assert!(
+            e.contains(name) && e.contains("not a glTF file") && !e.contains("line 1 column"),
+            "{name}: {e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    let e = load_error(&temp_file("empty.gltf", b" \n"));
+    assert!(e.contains("empty.gltf") && e.contains("empty, not a glTF file"), "{e}");
+    // JSON that is broken or not glTF stays "invalid glTF" with the parser's position or field.
+    let e = load_error(&temp_file("cut.gltf", b"{ \"asset\": { \"version\": "));
+    assert!(e.contains("cut.gltf") && e.contains("invalid glTF") && e.contains("line"), "{e}");
+    let e = load_error(&temp_file("other.gltf", b"{ \"name\": 1 }"));
+    assert!(e.contains("other.gltf") && e.contains("invalid glTF") && e.contains("asset"), "{e}");
 }

@@ -7,12 +7,13 @@ use glam::{Vec2, Vec3, Vec4};
 use restir_pt::gpu_types::{FrameParams, Material, Triangle, NO_EMITTER};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
+use restir_pt::shader_interface::SurfaceBinding;
 use restir_pt::shading::surface::{surface_at, triangle_bary, TriangleSurface};
 use restir_pt::shading::texture::{
     normal_mapped, texture_coordinates, texture_lookup, textured_material, MaterialTextures, SceneTextures, TextureHeader, TextureSlot,
     NO_TEXTURE, TEXTURE_NEAREST,
 };
-use restir_pt::vk::{Binding, Buffer, BufferUsage, Kernel};
+use restir_pt::vk::{Binding, BindingSlot, Buffer, BufferUsage, Kernel};
 
 use crate::common::{assert_clean, assert_vec3_close, close, gpu, TestRng, NAN_FILL};
 
@@ -181,13 +182,25 @@ fn compare_surfaces(scene: &Scene) {
     let input = Buffer::from_slice(&ctx, "inputs", &inputs).unwrap();
     let output = Buffer::new(&ctx, "outputs", (ITEMS * 8 * 16) as u64, BufferUsage::Storage).unwrap();
     output.fill(NAN_FILL).unwrap();
+    // The oracle binds everything in set 0: the surface family at 5-8 (SURFACE_SET 0,
+    // SURFACE_BINDING 5 in surface_oracle.comp), then the inputs and outputs.
+    let surface_slot = |b: SurfaceBinding| b.slot_at(0, 5, Binding::Storage);
     let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend(surface.buffers.iter());
-    buffers.extend([&input, &output]);
-    let mut kinds = scene_gpu.bindings();
-    kinds.extend([Binding::Storage; 6]);
-    let kernel = Kernel::new(&ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &kinds, 4).unwrap();
-    kernel.bind(&buffers);
+    buffers.extend(
+        SurfaceBinding::ALL
+            .iter()
+            .zip(&surface.buffers)
+            .map(|(&b, buffer)| surface_slot(b).to(buffer)),
+    );
+    buffers.extend([
+        BindingSlot::storage(9, "Inputs").to(&input),
+        BindingSlot::storage(10, "Outputs").to(&output),
+    ]);
+    let mut layout = scene_gpu.bindings();
+    layout.extend(SurfaceBinding::ALL.iter().map(|&b| surface_slot(b)));
+    layout.extend([BindingSlot::storage(9, "Inputs"), BindingSlot::storage(10, "Outputs")]);
+    let kernel = Kernel::new(&ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
+    kernel.bind(&buffers).unwrap();
     kernel.run_1d(ITEMS as u32, 64, bytemuck::bytes_of(&(ITEMS as u32))).unwrap();
     let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(ITEMS * 32).unwrap()).to_vec();
     let t = &scene.textures;

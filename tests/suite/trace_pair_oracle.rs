@@ -8,7 +8,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::scene::{load_scene, Scene};
-use restir_pt::vk::{Buffer, BufferUsage, Context, Kernel};
+use restir_pt::vk::{BindingSlot, Buffer, BufferUsage, Context, Kernel};
 
 use crate::bvh_oracle::random_scene;
 use crate::common::{assert_clean, close, gpu, TestRng};
@@ -65,12 +65,14 @@ fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairR
     let output = Buffer::new(ctx, "hits", pairs.len() as u64 * 32, BufferUsage::Storage).unwrap();
     let mut defines = scene_gpu.defines();
     defines.push(("SCENE_BRUTE_FORCE", if brute_force { "1" } else { "0" }));
-    let mut kinds = scene_gpu.bindings();
-    kinds.extend([restir_pt::vk::Binding::Storage, restir_pt::vk::Binding::Storage]);
-    let kernel = Kernel::new(ctx, "oracle/trace_pair_oracle.comp", &defines, &kinds, 4).unwrap();
     let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend([&input, &output]);
-    kernel.bind(&buffers);
+    buffers.extend([
+        BindingSlot::storage(5, "Inputs").to(&input),
+        BindingSlot::storage(6, "Outputs").to(&output),
+    ]);
+    let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
+    let kernel = Kernel::new(ctx, "oracle/trace_pair_oracle.comp", &defines, &layout, 4).unwrap();
+    kernel.bind(&buffers).unwrap();
     let count = pairs.len() as u32;
     kernel.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
     let out = output.read::<Vec4>(2 * pairs.len()).unwrap();

@@ -1,0 +1,120 @@
+//! The descriptor bindings a SPIR-V module declares, read from its decorations, and the check
+//! of a kernel's declared layout against them. Only what the kernels use is understood:
+//! buffer blocks, as uniform (`Uniform` + `Block`) or storage buffers
+//! (`StorageBuffer`, or `Uniform` + `BufferBlock`). The opcodes and enumerants are those of
+//! the SPIR-V 1.5 specification, section 3.
+
+use std::collections::HashMap;
+
+use super::Binding;
+
+const OP_NAME: u32 = 5;
+const OP_TYPE_POINTER: u32 = 32;
+const OP_VARIABLE: u32 = 59;
+const OP_DECORATE: u32 = 71;
+const DECORATION_BLOCK: u32 = 2;
+const DECORATION_BUFFER_BLOCK: u32 = 3;
+const DECORATION_BINDING: u32 = 33;
+const DECORATION_DESCRIPTOR_SET: u32 = 34;
+const STORAGE_CLASS_UNIFORM: u32 = 2;
+const STORAGE_CLASS_STORAGE_BUFFER: u32 = 12;
+
+/// One buffer binding of a SPIR-V module.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReflectedBinding {
+    pub set: u32,
+    pub binding: u32,
+    /// The block's type name (the GLSL block name), empty without debug names.
+    pub block: String,
+    pub kind: Binding,
+}
+
+fn spirv_string(words: &[u32]) -> String {
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).take_while(|&b| b != 0).collect();
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+/// The buffer bindings of `spirv` (a module's words, header included), sorted by set and
+/// binding. Malformed instructions end the scan rather than panic.
+pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
+    let mut names = HashMap::new();
+    let mut decorations: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut pointers = HashMap::new();
+    let mut variables = Vec::new();
+    let mut i = 5;
+    while i < spirv.len() {
+        let (count, op) = ((spirv[i] >> 16) as usize, spirv[i] & 0xffff);
+        if count == 0 || i + count > spirv.len() {
+            break;
+        }
+        let args = &spirv[i + 1..i + count];
+        match op {
+            OP_NAME if !args.is_empty() => {
+                names.insert(args[0], spirv_string(&args[1..]));
+            }
+            OP_DECORATE if args.len() >= 2 => {
+                decorations.insert((args[0], args[1]), args.get(2).copied().unwrap_or(0));
+            }
+            OP_TYPE_POINTER if args.len() >= 3 => {
+                pointers.insert(args[0], (args[1], args[2]));
+            }
+            OP_VARIABLE if args.len() >= 3 => variables.push((args[0], args[1], args[2])),
+            _ => {}
+        }
+        i += count;
+    }
+    let mut out: Vec<ReflectedBinding> = variables
+        .into_iter()
+        .filter_map(|(pointer, id, class)| {
+            let binding = *decorations.get(&(id, DECORATION_BINDING))?;
+            let set = decorations.get(&(id, DECORATION_DESCRIPTOR_SET)).copied().unwrap_or(0);
+            let &(_, block) = pointers.get(&pointer)?;
+            let kind = match class {
+                STORAGE_CLASS_STORAGE_BUFFER => Binding::Storage,
+                STORAGE_CLASS_UNIFORM if decorations.contains_key(&(block, DECORATION_BUFFER_BLOCK)) => Binding::Storage,
+                STORAGE_CLASS_UNIFORM if decorations.contains_key(&(block, DECORATION_BLOCK)) => Binding::Uniform,
+                _ => return None,
+            };
+            Some(ReflectedBinding {
+                set,
+                binding,
+                block: names.get(&block).cloned().unwrap_or_default(),
+                kind,
+            })
+        })
+        .collect();
+    out.sort_by_key(|b| (b.set, b.binding));
+    out
+}
+
+/// Checks that every binding `spirv` declares is in `layout` under the same set and number, block name
+/// and descriptor kind. A binding of `layout` the module lacks is allowed (the compiler drops
+/// blocks a kernel never reads). The error names the kernel, the binding and both sides.
+pub fn check_bindings(kernel: &str, spirv: &[u32], layout: &[super::BindingSlot]) -> Result<(), String> {
+    for (i, slot) in layout.iter().enumerate() {
+        if layout[..i]
+            .iter()
+            .any(|s| (s.set == slot.set && s.binding == slot.binding) || s.block == slot.block)
+        {
+            return Err(format!(
+                "kernel {kernel}: the host layout declares binding {} ({}) of set {} twice",
+                slot.binding, slot.block, slot.set
+            ));
+        }
+    }
+    for found in reflect_bindings(spirv) {
+        let Some(slot) = layout.iter().find(|s| s.set == found.set && s.binding == found.binding) else {
+            return Err(format!(
+                "kernel {kernel}: the shader declares binding {} ({}) of set {}, the host layout does not",
+                found.binding, found.block, found.set
+            ));
+        };
+        if slot.block != found.block || slot.kind != found.kind {
+            return Err(format!(
+                "kernel {kernel}: binding {} is {} ({:?}) in the shader but {} ({:?}) in the host layout (set {})",
+                found.binding, found.block, found.kind, slot.block, slot.kind, found.set
+            ));
+        }
+    }
+    Ok(())
+}
