@@ -1,10 +1,10 @@
 //! Command-line parsing and dispatch only; the commands and their options live in
-//! `restir_pt::cli`.
+//! `restir_pt::app`.
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use restir_pt::cli;
+use restir_pt::app;
 
 #[derive(Parser)]
 #[command(
@@ -21,39 +21,39 @@ struct Cli {
 enum Command {
     /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG with ReSTIR PT (default)
     /// or the path tracer.
-    Render(cli::RenderArgs),
+    Render(app::RenderArgs),
     /// Print a scene's triangles, emitters, lights, materials, bounds and cameras; with
     /// --kernels, the SPIR-V size and compile time of each kernel the scene would use.
-    Info(cli::InfoArgs),
+    Info(app::InfoArgs),
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
-    Bench(cli::BenchArgs),
+    Bench(app::BenchArgs),
     /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
-    Reference(cli::ReferenceArgs),
+    Reference(app::ReferenceArgs),
     /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out) and variance
     /// EXR (<out>.variance.exr) one `reference` process of the same seed and spp writes.
-    Merge(cli::MergeArgs),
+    Merge(app::MergeArgs),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
-    Profile(cli::ProfileArgs),
+    Profile(app::ProfileArgs),
     /// Error against GPU time per frame for each method at equal time budgets, against a
     /// reference: results.csv, log-log charts (SVG, PNG) and an equal-time image strip.
-    Compare(cli::CompareArgs),
+    Compare(app::CompareArgs),
     /// Every scene and method over F frames, static and moving camera: non-finite pixels (must
     /// be 0), energy and relMSE per frame against references, flicker and failed-shift rate.
-    Stability(cli::StabilityArgs),
+    Stability(app::StabilityArgs),
 }
 
 fn run(command: Option<Command>) -> anyhow::Result<()> {
     match command {
         // No command renders the default scene with the default settings.
-        None => cli::render(cli::RenderArgs::parse_defaults()?),
-        Some(Command::Render(args)) => cli::render(args),
-        Some(Command::Info(args)) => cli::info(args),
-        Some(Command::Bench(args)) => cli::bench(args),
-        Some(Command::Reference(args)) => cli::reference(args),
-        Some(Command::Merge(args)) => cli::merge(args),
-        Some(Command::Profile(args)) => cli::profile(args),
-        Some(Command::Compare(args)) => cli::compare(args).map(drop),
-        Some(Command::Stability(args)) => cli::stability(args).map(drop),
+        None => app::render(app::RenderArgs::parse_defaults()?),
+        Some(Command::Render(args)) => app::render(args),
+        Some(Command::Info(args)) => app::info(args),
+        Some(Command::Bench(args)) => app::bench(args),
+        Some(Command::Reference(args)) => app::reference(args),
+        Some(Command::Merge(args)) => app::merge(args),
+        Some(Command::Profile(args)) => app::profile(args),
+        Some(Command::Compare(args)) => app::compare(args).map(drop),
+        Some(Command::Stability(args)) => app::stability(args).map(drop),
     }
 }
 

@@ -50,7 +50,7 @@ impl Aabb {
 /// A BVH over `triangles`, which the build reorders so that leaves index them contiguously.
 pub struct Bvh {
     pub nodes: Vec<BvhNode>,
-    /// order[i] is the input index of the triangle now at position i.
+    /// `order[i]` is the input index of the triangle now at position i.
     pub order: Vec<u32>,
 }
 

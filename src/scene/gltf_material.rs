@@ -31,7 +31,7 @@ fn solve_metallic(diffuse: f32, specular: f32, one_minus_specular_strength: f32)
 }
 
 /// Specular-glossiness factors to (base colour, metallic, roughness), approximately: roughness is
-/// 1 - glossiness, metallic solves [`solve_metallic`], and the base colour blends the colour
+/// 1 - glossiness, metallic solves `solve_metallic`, and the base colour blends the colour
 /// implied by the diffuse term with the one implied by the specular term by metallic².
 pub fn spec_gloss_to_metal_rough(diffuse: Vec3, specular: Vec3, glossiness: f32) -> (Vec3, f32, f32) {
     let one_minus = 1.0 - specular.max_element();

@@ -2,7 +2,7 @@
 //! energy within 2% of the references) and `compare`'s files.
 
 use glam::Vec3;
-use restir_pt::cli::{equal_time_lines, parse_args, stability, CameraMotion, CompareRow, StabilityArgs};
+use restir_pt::app::{equal_time_lines, parse_args, stability, CameraMotion, CompareRow, StabilityArgs};
 use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
 
 use crate::common::{repo_path, temp_file};

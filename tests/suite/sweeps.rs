@@ -117,7 +117,7 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
 
     // The shards' sums are disjoint shares: a shard alone is a different, 4-spp estimate.
     let (_, _, one) = restir_pt::image_io::read_exr(&whole).unwrap();
-    let shard0 = restir_pt::cli::read_shard(&shards[0]).unwrap();
+    let shard0 = restir_pt::app::read_shard(&shards[0]).unwrap();
     assert_eq!((shard0.meta.first_sample, shard0.meta.spp, shard0.sums[0][3]), (0, 4, 4.0));
     let differs = shard0
         .sums
@@ -178,7 +178,7 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
 /// cwd), then its merge command; returns the merge's stdout.
 fn run_plan(plan: &Path, jobs: usize) -> String {
     let text = std::fs::read_to_string(plan).unwrap();
-    let lines: Vec<restir_pt::cli::JobLine> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lines: Vec<restir_pt::app::JobLine> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(lines.len(), jobs, "{text}");
     for (k, line) in lines.iter().enumerate() {
         assert_eq!((line.job, line.jobs), (k, jobs));

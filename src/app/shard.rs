@@ -244,7 +244,7 @@ pub struct MergeArgs {
     /// Shard EXRs written by `reference --shard I/N`.
     #[arg(required = true)]
     pub shards: Vec<PathBuf>,
-    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    /// Mean EXR; the variance goes next to it as NAME.variance.exr.
     #[arg(long)]
     pub out: PathBuf,
     /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.

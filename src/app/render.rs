@@ -70,7 +70,7 @@ pub struct RenderArgs {
     /// Folder for every frame of --frames (frame_0000.exr/png, ...).
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
-    /// Linear float RGB EXR output (default: out/<scene>.exr).
+    /// Linear float RGB EXR output (default: out/SCENE.exr).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Tonemapped sRGB PNG preview (default: next to the EXR).
@@ -162,7 +162,7 @@ impl RenderArgs {
     }
 }
 
-/// Where the images go: --out (default out/<scene>.exr), --png next to it.
+/// Where the images go: --out (default out/SCENE.exr), --png next to it.
 struct OutputPaths {
     out: PathBuf,
     png: PathBuf,

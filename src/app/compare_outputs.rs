@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::compare::{CompareArgs, CompareRow, Setup};
 use super::method_spec::MethodSpec;
-use crate::cli::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
+use crate::app::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
 use crate::metrics::{rel_mse, rel_squared_error};
 use crate::render::Image;
 

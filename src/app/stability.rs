@@ -22,7 +22,7 @@ use super::sweep::{
     SweepMode, COMMIT,
 };
 use super::{bundled_file, finish_device, load_with_warnings, open_device};
-use crate::cli::charts::{write_line_chart, LineChart, Series};
+use crate::app::charts::{write_line_chart, LineChart, Series};
 use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
 use crate::render::{PathTracer, RenderSettings};
 use crate::scene::{camera_on_path, Scene};
@@ -60,7 +60,7 @@ pub struct StabilityArgs {
     pub seed: u32,
     #[command(flatten)]
     pub restir: RestirArgs,
-    /// Folder for stability.csv and <scene>_rel_mse.svg/png.
+    /// Folder for stability.csv and SCENE_rel_mse.svg/png.
     #[arg(long, default_value = "out/stability")]
     pub out_dir: PathBuf,
     #[command(flatten)]
@@ -345,7 +345,7 @@ fn write_results(args: &StabilityArgs, setup: &Setup, rows: &[StabilityRow]) -> 
     }
     let dir = &args.out_dir;
     write_csv(&dir.join("stability.csv"), rows)?;
-    eprintln!("wrote stability.csv and <scene>_rel_mse.svg/png in {}", dir.display());
+    eprintln!("wrote stability.csv and SCENE_rel_mse.svg/png in {}", dir.display());
     let nonfinite: usize = rows.iter().map(|r| r.nonfinite_pixels).sum();
     if nonfinite > 0 {
         bail!("{nonfinite} non-finite pixels over all frames (see the summary above)");

@@ -220,10 +220,10 @@ pub struct SweepArgs {
     #[arg(long, value_name = "JOBS.jsonl")]
     pub plan: Option<PathBuf>,
     /// Run only job K (0-based) of the job list these arguments make; it writes
-    /// <out-dir>/jobs/job_K.csv/.json.
+    /// OUT_DIR/jobs/job_K.csv/.json.
     #[arg(long, value_name = "K")]
     pub job: Option<usize>,
-    /// Merge the jobs' files in DIR (normally <out-dir>/jobs) into the usual outputs and
+    /// Merge the jobs' files in DIR (normally OUT_DIR/jobs) into the usual outputs and
     /// accounting.csv.
     #[arg(long, value_name = "DIR")]
     pub merge: Option<PathBuf>,

@@ -26,7 +26,7 @@ pub struct ReferenceArgs {
     pub size: SizeArgs,
     #[command(flatten)]
     pub path: PathArgs,
-    /// Mean EXR; the variance goes next to it as <name>.variance.exr.
+    /// Mean EXR; the variance goes next to it as NAME.variance.exr.
     #[arg(long)]
     pub out: PathBuf,
     /// Write a reference with NaN or infinite pixels (with a warning) instead of failing.
