@@ -7,6 +7,7 @@
 #define LIGHTS_GLSL
 
 #include "sampling.glsl"
+#include "texture.glsl"
 #include "types.glsl"
 
 // Specialisation like the BSDF lobes: a scene without an environment or without emissive
@@ -94,9 +95,11 @@ void punctual_arrival(PunctualLight l, vec3 p, out vec3 dir, out float dist, out
     value = l.intensity * (spot_falloff(l, -dir) / d2);
 }
 
-// Emitted radiance of a triangle towards direction `to_viewer` (front face only unless double-sided).
-vec3 emitted_radiance(Triangle tri, vec3 to_viewer) {
-    Material m = materials[tri.material];
+// Emitted radiance of triangle index `triangle` at barycentrics bary towards direction
+// `to_viewer` (front face only unless double-sided), its emissive texture applied.
+vec3 emitted_radiance(uint triangle, vec2 bary, vec3 to_viewer) {
+    Triangle tri = triangles[triangle];
+    Material m = material_at(triangle, bary);
     float facing = dot(cross(tri.e1, tri.e2), to_viewer);
     bool lit = facing > 0.0 || ((m.flags & MATERIAL_DOUBLE_SIDED) != 0u && facing < 0.0);
     return lit ? m.emission : vec3(0.0);
@@ -257,7 +260,7 @@ LightSample sample_light(vec3 p, vec3 u) {
     if (d2 <= 0.0) return ls;
     ls.dist = sqrt(d2);
     ls.dir = to_light / ls.dist;
-    ls.radiance = emitted_radiance(tri, -ls.dir);
+    ls.radiance = emitted_radiance(e.triangle, b, -ls.dir);
     ls.pdf = emitter_pdf(e.triangle, ls.dir, ls.dist);
     return ls;
 }

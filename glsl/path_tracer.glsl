@@ -85,12 +85,12 @@ bool path_step(inout PathState s) {
         return false;
     }
     Triangle tri = triangles[hit.triangle];
-    Material m = materials[tri.material];
+    Material m = material_at(hit.triangle, hit.bary);
     vec3 ng = normalize(cross(tri.e1, tri.e2));
     vec3 x = tri.v0 + hit.bary.x * tri.e1 + hit.bary.y * tri.e2;
     vec3 wo = -s.dir;
     if (SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER) {
-        vec3 le = emitted_radiance(tri, wo);
+        vec3 le = emitted_radiance(hit.triangle, hit.bary, wo);
         float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, emitter_pdf(hit.triangle, s.dir, hit.t));
         s.radiance += s.beta * le * w;
     }

@@ -90,7 +90,7 @@ Vertex vertex_on_surface(uint triangle, vec3 pos) {
 
 Vertex vertex_escaped(vec3 dir) { return Vertex(dir, vec3(0.0), NO_HIT); }
 
-Material material_of(Vertex v) { return materials[triangles[v.triangle].material]; }
+Material material_of(Vertex v) { return material_at(v.triangle, triangle_bary(triangles[v.triangle], v.pos)); }
 
 bool vertex_is_rough(Vertex v, ShiftParams params) {
     if (vertex_is_escaped(v) || vertex_is_punctual(v)) return true;
@@ -164,7 +164,7 @@ vec3 end_emission(Vertex from, Vertex end) {
     }
     Triangle tri = triangles[end.triangle];
     if (tri.emitter == NO_EMITTER) return vec3(0.0);
-    return emitted_radiance(tri, normalize(from.pos - end.pos));
+    return emitted_radiance(end.triangle, triangle_bary(tri, end.pos), normalize(from.pos - end.pos));
 }
 
 // For a punctual light: the discrete probability of choosing it (whose ratio between two paths

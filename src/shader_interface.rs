@@ -15,10 +15,10 @@ use std::sync::OnceLock;
 use crate::render::{ReuseMis, ShiftKind};
 use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer};
 
-/// Declares one family of bindings of descriptor set 0: the enum, its GLSL macro prefix and
-/// `ALL`. Variant names are the GLSL block names.
+/// Declares one family of bindings of descriptor set `$set`: the enum, its GLSL macro prefix
+/// and `ALL`. Variant names are the GLSL block names.
 macro_rules! binding_family {
-    ($(#[$meta:meta])* $name:ident, $prefix:literal { $($(#[$vmeta:meta])* $variant:ident = $number:literal,)* }) => {
+    ($(#[$meta:meta])* $name:ident, $prefix:literal, set $set:literal { $($(#[$vmeta:meta])* $variant:ident = $number:literal,)* }) => {
         $(#[$meta])*
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum $name {
@@ -30,6 +30,8 @@ macro_rules! binding_family {
             pub const ALL: &'static [$name] = &[$($name::$variant),*];
             /// The prefix of the family's GLSL macros, e.g. `RESTIR_BINDING_`.
             pub const GLSL_PREFIX: &'static str = $prefix;
+            /// The descriptor set of the family.
+            pub const SET: u32 = $set;
 
             /// The GLSL block name, which is also the variant's name.
             pub fn block(self) -> &'static str {
@@ -38,7 +40,7 @@ macro_rules! binding_family {
                 }
             }
 
-            /// The binding number in descriptor set 0.
+            /// The binding number in descriptor set `SET`.
             pub fn binding(self) -> u32 {
                 self as u32
             }
@@ -46,6 +48,7 @@ macro_rules! binding_family {
             /// This binding with descriptor kind `kind`, for a kernel's layout.
             pub fn slot(self, kind: Binding) -> BindingSlot {
                 BindingSlot {
+                    set: Self::SET,
                     binding: self.binding(),
                     block: self.block(),
                     kind,
@@ -63,7 +66,7 @@ macro_rules! binding_family {
 binding_family! {
     /// Bindings 0-4 of every scene kernel (glsl/scene_bindings.glsl): the frame parameters and
     /// the scene arrays. The scene arrays are storage or uniform buffers (`SceneGpu::uniform`).
-    SceneBinding, "SCENE_BINDING_" {
+    SceneBinding, "SCENE_BINDING_", set 0 {
         /// `gpu_types::FrameParams`, a host-written storage buffer.
         FrameParams = 0,
         Triangles = 1,
@@ -76,7 +79,7 @@ binding_family! {
 
 binding_family! {
     /// Bindings 5-7 of glsl/pathtrace.comp, storage buffers.
-    PathTraceBinding, "PATHTRACE_BINDING_" {
+    PathTraceBinding, "PATHTRACE_BINDING_", set 0 {
         /// Per pixel vec4: rgb sum of L, w sample count.
         Accum = 5,
         /// Per pixel vec4: rgb sum of L².
@@ -90,7 +93,7 @@ binding_family! {
     /// Bindings 5-18 of the ReSTIR PT kernels (glsl/restir_bindings.glsl), storage buffers.
     /// Surfaces alternate between frames; reservoir slots rotate within and between frames
     /// (src/render/frame_plan.rs), each slot a head and a tail buffer.
-    RestirBinding, "RESTIR_BINDING_" {
+    RestirBinding, "RESTIR_BINDING_", set 0 {
         /// `gpu_types::ReuseParams`, host-written, with the frame's pass table.
         ReuseParams = 5,
         Surfaces0 = 6,
@@ -111,6 +114,37 @@ binding_family! {
         RestirStats = 17,
         /// Per reservoir vec4: the last resampling's expectation of f(Y) W_Y.
         Expectation = 18,
+    }
+}
+
+binding_family! {
+    /// Descriptor set 1 of scene kernels whose scene has surface attributes or textures
+    /// (glsl/surface_bindings.glsl, src/render/surface_gpu.rs), storage buffers. Set 0 keeps
+    /// what traversal reads; these are read only at hits. Oracle kernels that bind everything
+    /// in set 0 move the family there (`SURFACE_SET`, `SURFACE_BINDING` in the GLSL).
+    SurfaceBinding, "SURFACE_BINDING_", set 1 {
+        /// `TriangleSurface` per triangle (src/surface.rs).
+        SurfaceAttributes = 0,
+        /// `MaterialTextures` per material (src/texture.rs); this and the next two only with
+        /// textures.
+        MaterialTextureTable = 1,
+        /// `TextureHeader` per texture.
+        TextureHeaders = 2,
+        /// RGBA8 texels.
+        Texels = 3,
+    }
+}
+
+impl SurfaceBinding {
+    /// This binding moved to set `set` at `first` + its number, for oracle kernels that bind
+    /// everything in one set.
+    pub fn slot_at(self, set: u32, first: u32, kind: Binding) -> BindingSlot {
+        BindingSlot {
+            set,
+            binding: first + self.binding(),
+            block: self.block(),
+            kind,
+        }
     }
 }
 
@@ -187,6 +221,10 @@ fn build_header() -> String {
         (b.block(), b.binding())
     });
     write_family(&mut h, RestirBinding::GLSL_PREFIX, RestirBinding::ALL, |b| (b.block(), b.binding()));
+    write_family(&mut h, SurfaceBinding::GLSL_PREFIX, SurfaceBinding::ALL, |b| {
+        (b.block(), b.binding())
+    });
+    writeln!(h, "#define SURFACE_DESCRIPTOR_SET {}", SurfaceBinding::SET).expect("string write");
     h.push('\n');
     for kind in ShiftKind::ALL {
         writeln!(h, "#define {} {}", kind.glsl_name(), kind as u32).expect("string write");
@@ -228,6 +266,8 @@ mod tests {
         assert!(h.contains("#define RESTIR_BINDING_RESERVOIR_HEADS0 8\n"));
         assert!(h.contains("#define SCENE_BINDING_FRAME_PARAMS 0\n"));
         assert!(h.contains("#define PATHTRACE_BINDING_ACCUM_SQ 6\n"));
+        assert!(h.contains("#define SURFACE_BINDING_TEXELS 3\n"));
+        assert!(h.contains("#define SURFACE_DESCRIPTOR_SET 1\n"));
         assert!(h.contains("#define SHIFT_HYBRID 2\n"));
         assert!(h.contains("#define MIS_PAIRWISE 1\n"));
         assert!(h.contains("#define MAX_INPUTS 9u\n"));
@@ -246,6 +286,9 @@ mod tests {
         assert_eq!(restir, (5..19).collect::<Vec<_>>());
         let pt: Vec<u32> = PathTraceBinding::ALL.iter().map(|b| b.binding()).collect();
         assert_eq!(pt, (5..8).collect::<Vec<_>>());
+        let surface: Vec<u32> = SurfaceBinding::ALL.iter().map(|b| b.binding()).collect();
+        assert_eq!(surface, (0..4).collect::<Vec<_>>());
+        assert_eq!((SceneBinding::SET, RestirBinding::SET, SurfaceBinding::SET), (0, 0, 1));
         for slot in 0..RESERVOIR_SLOTS {
             let (h, t) = RestirBinding::reservoir_slot(slot);
             assert_eq!(

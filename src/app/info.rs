@@ -96,6 +96,9 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
         scene.build_ms
     );
     println!("BVH nodes: {}", scene.nodes.len());
+    if let Some(line) = scene.surface_summary() {
+        println!("{line}");
+    }
     println!(
         "emitters: {} triangles, power {:.4} (luminance W)",
         scene.emitters.len(),

@@ -262,6 +262,9 @@ pub fn render(args: RenderArgs) -> Result<()> {
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;
     let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.scene_array_limit())))?;
+    if let Some(line) = scene.surface_summary() {
+        eprintln!("{line}");
+    }
     if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
         eprintln!(
             "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",

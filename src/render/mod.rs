@@ -10,6 +10,7 @@ mod restir;
 mod restir_settings;
 mod scene_gpu;
 mod settings;
+mod surface_gpu;
 
 pub use counters::TraversalCounters;
 pub use frame_plan::{plan_frame, FramePlan, FrameState, History, PassKernel, PlannedPass, PASS_NAMES};
@@ -19,3 +20,4 @@ pub use restir::{FrameStats, Restir};
 pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
 pub use scene_gpu::SceneGpu;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};
+pub use surface_gpu::SurfaceGpu;

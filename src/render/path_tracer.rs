@@ -104,7 +104,7 @@ impl PathTracer {
         if counters {
             defines.push(("TRAVERSAL_COUNTERS", "1"));
         }
-        let mut kernel = Kernel::new(ctx, "pathtrace.comp", &defines, &bindings, 0)?;
+        let mut kernel = scene_gpu.kernel(ctx, "pathtrace.comp", &defines, bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
         buffers.extend([
             PathTraceBinding::Accum.to(&accum),

@@ -267,7 +267,7 @@ fn build_kernels(ctx: &Arc<Context>, scene_gpu: &SceneGpu, restir: &RestirSettin
     for kernel in PassKernel::ALL {
         let (file, extra) = kernel.source();
         let all: Vec<_> = defines.iter().chain(extra).copied().collect();
-        let mut k = Kernel::new(ctx, file, &all, &layout, 4)?;
+        let mut k = scene_gpu.kernel(ctx, file, &all, layout.clone(), 4)?;
         if kernel == PassKernel::TemporalUnmoved {
             k.set_variant("(unmoved camera)");
         }

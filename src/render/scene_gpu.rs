@@ -16,7 +16,10 @@ use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
 use crate::shader_interface::SceneBinding;
 use crate::shading::bsdf::{has_specular_layer, lobe_weights};
-use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context};
+use crate::shading::texture::NO_TEXTURE;
+use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context, Kernel};
+
+use super::surface_gpu::SurfaceGpu;
 
 pub struct SceneGpu {
     pub triangles: Buffer,
@@ -28,6 +31,8 @@ pub struct SceneGpu {
     /// With the addressed layout: the records bound in place of the triangles, nodes and
     /// emitters (address, then length; see `address_record`).
     addresses: Option<[Buffer; 3]>,
+    /// Surface attributes and textures (descriptor set 1), if the scene has any.
+    pub surface: Option<SurfaceGpu>,
     defines: Vec<(&'static str, String)>,
 }
 
@@ -114,6 +119,7 @@ impl SceneGpu {
             emitters,
             uniform,
             addresses,
+            surface: SurfaceGpu::upload(ctx, scene)?,
             defines,
         })
     }
@@ -150,6 +156,31 @@ impl SceneGpu {
             .collect()
     }
 
+    /// The layout of a scene kernel whose set 0 is `set0`: set 1 (`SurfaceBinding`) holds the
+    /// surface attributes and textures when the scene has them.
+    pub fn layout(&self, mut set0: Vec<BindingSlot>) -> Vec<BindingSlot> {
+        if let Some(s) = &self.surface {
+            set0.extend(s.bindings());
+        }
+        set0
+    }
+
+    /// Builds scene kernel glsl/`name` with set 0 `set0` (bound by the caller) and binds set 1.
+    pub fn kernel(
+        &self,
+        ctx: &Arc<Context>,
+        name: &str,
+        defines: &[(&str, &str)],
+        set0: Vec<BindingSlot>,
+        push_bytes: u32,
+    ) -> Result<Kernel> {
+        let kernel = Kernel::new(ctx, name, defines, &self.layout(set0), push_bytes)?;
+        if let Some(s) = &self.surface {
+            kernel.bind(&s.bound())?;
+        }
+        Ok(kernel)
+    }
+
     /// The `#define`s every scene kernel is compiled with.
     pub fn defines(&self) -> Vec<(&str, &str)> {
         self.defines.iter().map(|(k, v)| (*k, v.as_str())).collect()
@@ -159,19 +190,38 @@ impl SceneGpu {
 /// Specialises kernels to the BSDF lobes and light types the scene uses, and sizes the uniform
 /// arrays when the scene is bound as uniform buffers.
 fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
-    let used = |pick: fn((f32, f32, f32)) -> f32| scene.materials.iter().any(|m| pick(lobe_weights(m)) > 0.0);
+    // A metallic-roughness texture scales metallic anywhere down to 0, which brings in the
+    // non-metal lobes.
+    let variants: Vec<Material> = scene
+        .materials
+        .iter()
+        .enumerate()
+        .flat_map(|(i, m)| {
+            let textured = scene
+                .textures
+                .materials
+                .get(i)
+                .is_some_and(|t| t.metal_rough.texture_index != NO_TEXTURE);
+            let dielectric = Material { metallic: 0.0, ..*m };
+            std::iter::once(*m).chain(textured.then_some(dielectric))
+        })
+        .collect();
+    let used = |pick: fn((f32, f32, f32)) -> f32| variants.iter().any(|m| pick(lobe_weights(m)) > 0.0);
     let flag = |on: bool| if on { "1" } else { "0" }.to_string();
     let mut defines = vec![
         ("BSDF_DIFFUSE", flag(used(|w| w.0))),
         ("BSDF_CONDUCTOR", flag(used(|w| w.1))),
         ("BSDF_DIELECTRIC", flag(used(|w| w.2))),
-        ("BSDF_SPECULAR", flag(scene.materials.iter().any(has_specular_layer))),
+        // The layer needs a non-metal lobe, which a metallic texture can give a metal factor.
+        ("BSDF_SPECULAR", flag(variants.iter().any(has_specular_layer))),
         ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
         ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),
         ("SCENE_ENV_MAP", flag(scene.environment_map.is_some())),
         ("SCENE_ENV_MAP_BASE", format!("{}u", PUNCTUAL_ROWS * scene.lights.len())),
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
+        ("SCENE_SURFACE", flag(!scene.surfaces.is_empty())),
+        ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
     ];
     if uniform {
         defines.extend([

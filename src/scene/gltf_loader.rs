@@ -13,6 +13,8 @@ use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
 use crate::gpu_types::{Material, Triangle};
 use crate::scene::environment::EnvironmentMap;
+use crate::shading::surface::TriangleSurface;
+use crate::shading::texture::SceneTextures;
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
 pub(super) const MAX_NODE_DEPTH: usize = 256;
@@ -22,12 +24,19 @@ pub(super) const MAX_TRIANGLES: usize = 1 << 26;
 
 pub(super) struct Loader<'a> {
     pub(super) path: &'a Path,
+    /// The folder external images resolve against (none: only embedded images).
+    pub(super) base: Option<&'a Path>,
     pub(super) doc: &'a gltf::Document,
     pub(super) buffers: &'a [gltf::buffer::Data],
     pub(super) instancing: &'a HashMap<usize, Instancing>,
     pub(super) triangles: Vec<Triangle>,
+    /// Vertex attributes parallel to `triangles`, from the first triangle that has any (earlier
+    /// ones are flat); empty while none has.
+    pub(super) surfaces: Vec<TriangleSurface>,
     pub(super) materials: Vec<Material>,
     pub(super) material_names: Vec<String>,
+    /// The glTF material each of `materials` comes from (none: the default material).
+    pub(super) material_sources: Vec<Option<usize>>,
     /// Whether each material is `KHR_materials_unlit` (its emission is its base colour).
     pub(super) unlit: Vec<bool>,
     /// Index of the glTF default material in `materials`, added on first use.
@@ -54,6 +63,8 @@ pub(super) struct MeshCounts {
     pub degenerate_emitters: usize,
     pub points_or_lines: usize,
     pub colour_varying: usize,
+    /// Some vertex normal differs from its face's normal.
+    pub smooth: bool,
     pub instances: usize,
     /// World-space bounds of the skipped points and lines (frame a scene made only of them).
     pub skipped_bounds: Option<(Vec3, Vec3)>,
@@ -138,12 +149,15 @@ fn load_parts(
     }
     let mut loader = Loader {
         path,
+        base,
         doc: &document,
         buffers: &buffers,
         instancing: &raw.instancing,
         triangles: Vec::new(),
+        surfaces: Vec::new(),
         materials: Vec::new(),
         material_names: Vec::new(),
+        material_sources: Vec::new(),
         unlit: Vec::new(),
         default_material: None,
         colour_variants: HashMap::new(),
@@ -263,7 +277,10 @@ impl<'a> Loader<'a> {
             None => scene_environment(self.path, &scene, doc)?,
         };
         let map = options.environment_map.as_deref().map(EnvironmentMap::load).transpose()?;
-        self.finish(environment, map)
+        let sources = std::mem::take(&mut self.material_sources);
+        // Texel offsets are 32-bit; the device's binding limit is checked at upload.
+        let textures = self.load_textures(&sources, 4 * u32::MAX as u64)?;
+        self.finish(environment, map, textures)
     }
 
     /// Walks the hierarchy in f64 and re-centres the scene before rounding to f32: on its first
@@ -349,9 +366,19 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>) -> Result<LoadedParts> {
+    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>, textures: SceneTextures) -> Result<LoadedParts> {
         let this = self;
         let skipped_bounds = this.counts.skipped_bounds;
+        // Flat faces without textures need no attributes: their kernels do without.
+        let surfaces = if this.counts.smooth || !textures.is_empty() {
+            let mut s = std::mem::take(&mut this.surfaces);
+            if !s.is_empty() {
+                s.resize(this.triangles.len(), TriangleSurface::flat());
+            }
+            s
+        } else {
+            Vec::new()
+        };
         this.report_counts();
         let bounds = match skipped_bounds {
             Some(b) if this.triangles.is_empty() => {
@@ -385,6 +412,8 @@ impl<'a> Loader<'a> {
         let parts = SceneParts {
             source: this.path.to_path_buf(),
             triangles: std::mem::take(&mut this.triangles),
+            surfaces,
+            textures,
             materials: std::mem::take(&mut this.materials),
             material_names: std::mem::take(&mut this.material_names),
             environment,

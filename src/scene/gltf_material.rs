@@ -55,6 +55,7 @@ impl Loader<'_> {
             let material = self.convert_material(&m, &name)?;
             self.materials.push(material);
             self.material_names.push(name);
+            self.material_sources.push(m.index());
             self.unlit.push(m.unlit());
         }
         let unlit = self.unlit.iter().filter(|&&u| u).count();
@@ -74,12 +75,10 @@ impl Loader<'_> {
     fn warn_ignored_textures(&mut self, m: &gltf::Material, name: &str) {
         let pbr = m.pbr_metallic_roughness();
         let sg = m.pbr_specular_glossiness();
+        // The occlusion texture is not read and not reported: it approximates the occlusion that
+        // path tracing computes.
+        let _ = &pbr;
         let ignored_textures = [
-            ("base colour", pbr.base_color_texture().is_some()),
-            ("metallic-roughness", pbr.metallic_roughness_texture().is_some()),
-            ("normal", m.normal_texture().is_some()),
-            ("occlusion", m.occlusion_texture().is_some()),
-            ("emissive", m.emissive_texture().is_some()),
             ("transmission", m.transmission().is_some_and(|t| t.transmission_texture().is_some())),
             ("specular", m.specular().is_some_and(|s| s.specular_texture().is_some())),
             (
@@ -94,9 +93,7 @@ impl Loader<'_> {
         ];
         for (kind, present) in ignored_textures {
             if present {
-                self.warn(format!(
-                    "{name}: {kind} texture ignored (textures are not supported; factors are used)"
-                ));
+                self.warn(format!("{name}: {kind} texture ignored (its factor is used)"));
             }
         }
     }
@@ -192,6 +189,7 @@ impl Loader<'_> {
                 ..Default::default()
             });
             self.material_names.push("glTF default material".to_string());
+            self.material_sources.push(None);
             self.unlit.push(false);
             (self.materials.len() - 1) as u32
         })
@@ -216,6 +214,7 @@ impl Loader<'_> {
         let name = format!("{} × COLOR_0 {:?}", self.material_names[material as usize], colour.to_array());
         self.materials.push(m);
         self.material_names.push(name);
+        self.material_sources.push(self.material_sources[material as usize]);
         self.unlit.push(self.unlit[material as usize]);
         let v = (self.materials.len() - 1) as u32;
         self.colour_variants.insert(key, v);

@@ -9,6 +9,7 @@ use glam::{DMat4, DQuat, DVec3, Vec3};
 use super::gltf_json::Instancing;
 use super::gltf_loader::{problem, Loader, MAX_TRIANGLES};
 use crate::gpu_types::{Triangle, NO_EMITTER};
+use crate::shading::surface::TriangleSurface;
 
 /// Vertex colours are rounded to this step before materials are shared between triangles.
 const COLOUR_STEP: f32 = 1.0 / 4096.0;
@@ -176,14 +177,17 @@ impl Loader<'_> {
                 Some(i) => i as u32,
                 None => self.default_material(),
             };
-            for tri in tris {
+            let surface = self.read_surface(mesh, &prim, world, &positions, &tris);
+            let order = if flip { [0, 2, 1] } else { [0, 1, 2] };
+            for (k, tri) in tris.iter().enumerate() {
                 let material = match &colours {
                     Some(c) => self.vertex_colour_material(material, tri.map(|k| c[k as usize])),
                     None => material,
                 };
-                let [a, b, c] = tri.map(|k| placed[k as usize]);
-                let (b, c) = if flip { (c, b) } else { (b, c) };
-                self.push_triangle(a, b, c, material)?;
+                let [a, b, c] = order.map(|o| placed[tri[o] as usize]);
+                let face = (b - a).cross(c - a).normalize_or_zero().as_vec3();
+                let attributes = surface.as_ref().map(|s| Self::triangle_surface(s, k, *tri, order, face));
+                self.push_triangle(a, b, c, material, attributes)?;
             }
         }
         Ok(())
@@ -201,7 +205,8 @@ impl Loader<'_> {
 
     /// Adds triangle (a, b, c) in scene coordinates (f64); the edges are taken in f64 before
     /// rounding, so they keep their precision whatever the rounding of `a`.
-    fn push_triangle(&mut self, a: DVec3, b: DVec3, c: DVec3, material: u32) -> Result<()> {
+    /// `surface`: the triangle's vertex attributes and whether they make it smooth-shaded.
+    fn push_triangle(&mut self, a: DVec3, b: DVec3, c: DVec3, material: u32, surface: Option<(TriangleSurface, bool)>) -> Result<()> {
         let emissive = Vec3::from(self.materials[material as usize].emission).max_element() > 0.0;
         let (e1, e2) = ((b - a).as_vec3(), (c - a).as_vec3());
         let a = a.as_vec3();
@@ -214,6 +219,12 @@ impl Loader<'_> {
         }
         if self.triangles.len() >= MAX_TRIANGLES {
             bail!(problem(self.path, format!("more than {MAX_TRIANGLES} triangles")));
+        }
+        if let Some((attributes, smooth)) = surface {
+            // The attribute array starts with the first triangle that has attributes.
+            self.surfaces.resize(self.triangles.len(), TriangleSurface::flat());
+            self.surfaces.push(attributes);
+            self.counts.smooth |= smooth;
         }
         self.triangles.push(Triangle {
             v0: a.into(),

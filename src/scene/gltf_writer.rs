@@ -4,6 +4,10 @@
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 
+mod textures;
+
+pub use textures::{textured_sphere, FILTER_LINEAR, FILTER_NEAREST, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT};
+
 #[derive(Debug, Clone, Copy)]
 pub struct MaterialSpec {
     pub base_color: Vec3,
@@ -151,6 +155,9 @@ pub struct GltfBuilder {
     extensions_used: Vec<&'static str>,
     required: Vec<&'static str>,
     lights: Vec<Value>,
+    images: Vec<Value>,
+    samplers: Vec<Value>,
+    textures: Vec<Value>,
 }
 
 /// glTF's primitive mode for triangle lists (the default).
@@ -357,6 +364,11 @@ impl GltfBuilder {
             "bufferViews": self.buffer_views,
             "buffers": [{ "byteLength": self.buffer.len(), "uri": format!("data:application/octet-stream;base64,{}", base64_encode(&self.buffer)) }],
         });
+        for (key, list) in [("images", self.images), ("samplers", self.samplers), ("textures", self.textures)] {
+            if !list.is_empty() {
+                root[key] = Value::Array(list);
+            }
+        }
         if !self.extensions_used.is_empty() {
             root["extensionsUsed"] = json!(self.extensions_used);
         }

@@ -9,7 +9,10 @@ mod gltf_json;
 mod gltf_loader;
 mod gltf_material;
 mod gltf_mesh;
+mod gltf_surface;
+mod gltf_texture;
 pub mod gltf_writer;
+mod hit_surface;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
@@ -25,6 +28,8 @@ use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUA
 use crate::scene::bvh::Bvh;
 use crate::scene::environment::EnvironmentMap;
 use crate::shading::lights::build_alias_table;
+use crate::shading::surface::TriangleSurface;
+use crate::shading::texture::SceneTextures;
 
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
@@ -32,6 +37,11 @@ const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
 pub struct Scene {
     pub source: PathBuf,
     pub triangles: Vec<Triangle>,
+    /// Vertex attributes of `triangles` (same order), or empty: a scene of flat faces without
+    /// textures has none (see src/surface.rs).
+    pub surfaces: Vec<TriangleSurface>,
+    /// The materials' textures (empty: none).
+    pub textures: SceneTextures,
     pub nodes: Vec<BvhNode>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
@@ -69,6 +79,9 @@ pub fn luminance(c: Vec3) -> f32 {
 pub struct SceneParts {
     pub source: PathBuf,
     pub triangles: Vec<Triangle>,
+    /// Vertex attributes parallel to `triangles`, or empty.
+    pub surfaces: Vec<TriangleSurface>,
+    pub textures: SceneTextures,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     pub environment: Vec3,
@@ -85,6 +98,12 @@ impl Scene {
         let start = std::time::Instant::now();
         let bvh = Bvh::build(&parts.triangles);
         let mut triangles = parts.triangles;
+        // The surface attributes are per triangle and must follow the triangles' BVH order;
+        // scenes without attributes keep an empty array (no SCENE_SURFACE).
+        let mut surfaces = parts.surfaces;
+        if !surfaces.is_empty() {
+            permute_in_place(&mut surfaces, bvh.order.clone());
+        }
         permute_in_place(&mut triangles, bvh.order);
         let mut emitter_tris = Vec::new();
         let mut powers = Vec::new();
@@ -127,6 +146,8 @@ impl Scene {
         Scene {
             source: parts.source,
             triangles,
+            surfaces,
+            textures: parts.textures,
             nodes: bvh.nodes,
             materials: parts.materials,
             material_names: parts.material_names,

@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::gpu_types::{Emitter, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use crate::gpu_types::{Emitter, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::{PunctualKind, PunctualLight, Scene};
 use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
@@ -110,8 +110,11 @@ pub fn build_alias_table(triangles: &[u32], weights: &[f32]) -> Vec<Emitter> {
     table
 }
 
-pub fn emitted_radiance(scene: &Scene, tri: &Triangle, to_viewer: Vec3) -> Vec3 {
-    let m = &scene.materials[tri.material as usize];
+/// Emitted radiance of triangle index `triangle` at barycentrics `bary` towards `to_viewer`
+/// (front face only unless double-sided), its emissive texture applied.
+pub fn emitted_radiance(scene: &Scene, triangle: u32, bary: glam::Vec2, to_viewer: Vec3) -> Vec3 {
+    let tri = &scene.triangles[triangle as usize];
+    let m = &scene.material_at(triangle, bary);
     let facing = tri.normal_area2().dot(to_viewer);
     let lit = facing > 0.0 || (m.is_double_sided() && facing < 0.0);
     if lit {
@@ -222,7 +225,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
     LightSample {
         dir,
         dist,
-        radiance: emitted_radiance(scene, tri, -dir),
+        radiance: emitted_radiance(scene, e.triangle, b, -dir),
         pdf: emitter_pdf(scene, e.triangle, dir, dist),
         triangle: e.triangle,
     }

@@ -12,3 +12,5 @@ pub mod ray_offset;
 pub mod rng;
 pub mod sampling;
 pub mod shift;
+pub mod surface;
+pub mod texture;

@@ -38,6 +38,7 @@ use crate::shading::path_record::{record_length, record_lobe, record_nee_end, re
 use crate::shading::ray_offset::offset_ray_origin;
 use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 use crate::shading::sampling::balance_heuristic;
+use crate::shading::surface::triangle_bary;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
 pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
@@ -192,7 +193,7 @@ pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool 
     if vertex_is_escaped(v) || vertex_is_punctual(v) {
         return true;
     }
-    let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
+    let m = &material_of(scene, v);
     let (_, w_c, w_t) = lobe_weights(m);
     let w_c = if has_specular_layer(m) { 1.0 } else { w_c };
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
@@ -213,7 +214,7 @@ pub fn reconnection_index(scene: &Scene, path: &Path, params: &ShiftParams) -> O
 }
 
 pub(crate) fn material_of(scene: &Scene, v: &Vertex) -> Material {
-    scene.materials[scene.triangles[v.triangle as usize].material as usize]
+    scene.material_at(v.triangle, triangle_bary(&scene.triangles[v.triangle as usize], v.pos))
 }
 
 /// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
@@ -261,7 +262,7 @@ pub(crate) fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     if tri.emitter == NO_EMITTER {
         return Vec3::ZERO;
     }
-    emitted_radiance(scene, tri, (from.pos - end.pos).normalize())
+    emitted_radiance(scene, end.triangle, triangle_bary(tri, end.pos), (from.pos - end.pos).normalize())
 }
 
 /// Solid-angle pdf that NEE at `from` picks `end`; for a punctual light the discrete probability

@@ -1,5 +1,5 @@
-//! A compute pipeline with one descriptor set of buffers, bound by name, and an optional
-//! push-constant block.
+//! A compute pipeline with descriptor sets of buffers (set 0, and set 1 for the scene's surface
+//! attributes and textures), bound by name, and an optional push-constant block.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,19 +17,21 @@ pub enum Binding {
     Storage,
 }
 
-/// One binding of a kernel's descriptor set 0: its number, the GLSL block declared there and
+/// One binding of a kernel: its descriptor set and number, the GLSL block declared there and
 /// its descriptor kind. src/shader_interface.rs declares those of the renderers' kernels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BindingSlot {
+    pub set: u32,
     pub binding: u32,
     pub block: &'static str,
     pub kind: Binding,
 }
 
 impl BindingSlot {
-    /// A storage-buffer binding.
+    /// A storage-buffer binding of set 0.
     pub fn storage(binding: u32, block: &'static str) -> Self {
         Self {
+            set: 0,
             binding,
             block,
             kind: Binding::Storage,
@@ -83,19 +85,22 @@ impl KernelCompile {
 pub struct Kernel {
     pub name: String,
     compile: KernelCompile,
+    /// The bindings of every set.
     bindings: Vec<BindingSlot>,
     push_bytes: u32,
     pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
-    set_layout: vk::DescriptorSetLayout,
+    /// One layout and one descriptor set per set number up to the highest the bindings use (a
+    /// set without bindings still gets its empty layout, so that later sets keep their numbers).
+    set_layouts: Vec<vk::DescriptorSetLayout>,
     pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
+    sets: Vec<vk::DescriptorSet>,
     module: vk::ShaderModule,
     ctx: Arc<Context>,
 }
 
 impl Kernel {
-    /// Builds the kernel glsl/`name` whose set 0 has the bindings `layout`. Fails when the
+    /// Builds the kernel glsl/`name` with the bindings `layout` (of any sets). Fails when the
     /// compiled shader declares a binding that `layout` lacks or names differently.
     pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], layout: &[BindingSlot], push_bytes: u32) -> Result<Self> {
         let start = Instant::now();
@@ -146,28 +151,33 @@ impl Kernel {
             push_bytes,
             pipeline: vk::Pipeline::null(),
             layout: vk::PipelineLayout::null(),
-            set_layout: vk::DescriptorSetLayout::null(),
+            set_layouts: Vec::new(),
             pool: vk::DescriptorPool::null(),
-            set: vk::DescriptorSet::null(),
+            sets: Vec::new(),
             module: vk::ShaderModule::null(),
             ctx: ctx.clone(),
         };
         let module_info = vk::ShaderModuleCreateInfo::default().code(spirv);
         kernel.module = unsafe { device.create_shader_module(&module_info, None) }.map_err(vk_error("creating a shader module"))?;
-        let layout_bindings: Vec<_> = bindings
-            .iter()
-            .map(|b| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b.binding)
-                    .descriptor_type(b.kind.descriptor_type())
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        let set_layout_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
-        kernel.set_layout =
-            unsafe { device.create_descriptor_set_layout(&set_layout_info, None) }.map_err(vk_error("creating a descriptor set layout"))?;
-        let set_layouts = [kernel.set_layout];
+        let set_count = bindings.iter().map(|b| b.set + 1).max().unwrap_or(1);
+        for set in 0..set_count {
+            let layout_bindings: Vec<_> = bindings
+                .iter()
+                .filter(|b| b.set == set)
+                .map(|b| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(b.binding)
+                        .descriptor_type(b.kind.descriptor_type())
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::COMPUTE)
+                })
+                .collect();
+            let set_layout_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
+            let set_layout = unsafe { device.create_descriptor_set_layout(&set_layout_info, None) }
+                .map_err(vk_error("creating a descriptor set layout"))?;
+            kernel.set_layouts.push(set_layout);
+        }
+        let set_layouts = kernel.set_layouts.clone();
         let ranges = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::COMPUTE)
             .size(push_bytes)];
@@ -192,40 +202,55 @@ impl Kernel {
                 sizes.push(vk::DescriptorPoolSize::default().ty(kind.descriptor_type()).descriptor_count(count));
             }
         }
-        let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
+        let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(set_count).pool_sizes(&sizes);
         kernel.pool = unsafe { device.create_descriptor_pool(&pool_info, None) }.map_err(vk_error("creating a descriptor pool"))?;
         let alloc_info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(kernel.pool)
             .set_layouts(&set_layouts);
-        kernel.set = unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_error("allocating a descriptor set"))?[0];
+        kernel.sets = unsafe { device.allocate_descriptor_sets(&alloc_info) }.map_err(vk_error("allocating descriptor sets"))?;
         Ok(kernel)
     }
 
-    /// Points each binding of the layout at its buffer in `buffers`, matched by number and
-    /// checked by block name and kind; every binding of the layout must be given exactly once.
-    /// The caller keeps the buffers alive while dispatching.
+    /// Points each binding of the layout at its buffer in `buffers`, matched by set and number
+    /// and checked by block name and kind; every binding of each set that `buffers` touches
+    /// must be given exactly once (sets are bound separately: a scene's set 1 once at build,
+    /// set 0 by the renderer). The caller keeps the buffers alive while dispatching.
     pub fn bind(&self, buffers: &[BoundBuffer]) -> Result<()> {
+        let same = |a: &BindingSlot, b: &BindingSlot| a.set == b.set && a.binding == b.binding;
         for (i, bound) in buffers.iter().enumerate() {
             let slot = bound.slot;
             if !self.bindings.contains(&slot) {
                 anyhow::bail!(
-                    "kernel {}: its layout has no binding {} {} ({:?})",
+                    "kernel {}: its layout has no binding {} {} ({:?}) in set {}",
                     self.name,
                     slot.binding,
                     slot.block,
-                    slot.kind
+                    slot.kind,
+                    slot.set
                 );
             }
-            if buffers[..i].iter().any(|b| b.slot.binding == slot.binding) {
-                anyhow::bail!("kernel {}: binding {} ({}) given twice", self.name, slot.binding, slot.block);
+            if buffers[..i].iter().any(|b| same(&b.slot, &slot)) {
+                anyhow::bail!(
+                    "kernel {}: binding {} ({}) of set {} given twice",
+                    self.name,
+                    slot.binding,
+                    slot.block,
+                    slot.set
+                );
             }
         }
-        if let Some(missing) = self.bindings.iter().find(|s| !buffers.iter().any(|b| b.slot.binding == s.binding)) {
+        if let Some(missing) = self
+            .bindings
+            .iter()
+            .filter(|s| buffers.iter().any(|b| b.slot.set == s.set))
+            .find(|s| !buffers.iter().any(|b| same(&b.slot, s)))
+        {
             anyhow::bail!(
-                "kernel {}: no buffer for binding {} ({})",
+                "kernel {}: no buffer for binding {} ({}) of set {}",
                 self.name,
                 missing.binding,
-                missing.block
+                missing.block,
+                missing.set
             );
         }
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
@@ -242,7 +267,7 @@ impl Kernel {
             .zip(buffers)
             .map(|(info, bound)| {
                 vk::WriteDescriptorSet::default()
-                    .dst_set(self.set)
+                    .dst_set(self.sets[bound.slot.set as usize])
                     .dst_binding(bound.slot.binding)
                     .descriptor_type(bound.slot.kind.descriptor_type())
                     .buffer_info(info)
@@ -264,7 +289,7 @@ impl Kernel {
         let device = &self.ctx.device;
         unsafe {
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.set], &[]);
+            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &self.sets, &[]);
             if !push.is_empty() {
                 device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
@@ -322,7 +347,9 @@ impl Drop for Kernel {
             device.destroy_pipeline(self.pipeline, None);
             device.destroy_pipeline_layout(self.layout, None);
             device.destroy_descriptor_pool(self.pool, None);
-            device.destroy_descriptor_set_layout(self.set_layout, None);
+            for &set_layout in &self.set_layouts {
+                device.destroy_descriptor_set_layout(set_layout, None);
+            }
             device.destroy_shader_module(self.module, None);
         }
     }

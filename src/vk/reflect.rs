@@ -1,6 +1,6 @@
 //! The descriptor bindings a SPIR-V module declares, read from its decorations, and the check
 //! of a kernel's declared layout against them. Only what the kernels use is understood:
-//! buffer blocks in set 0, as uniform (`Uniform` + `Block`) or storage buffers
+//! buffer blocks, as uniform (`Uniform` + `Block`) or storage buffers
 //! (`StorageBuffer`, or `Uniform` + `BufferBlock`). The opcodes and enumerants are those of
 //! the SPIR-V 1.5 specification, section 3.
 
@@ -87,35 +87,32 @@ pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
     out
 }
 
-/// Checks that every binding `spirv` declares is in `layout` under the same number, block name
+/// Checks that every binding `spirv` declares is in `layout` under the same set and number, block name
 /// and descriptor kind. A binding of `layout` the module lacks is allowed (the compiler drops
 /// blocks a kernel never reads). The error names the kernel, the binding and both sides.
 pub fn check_bindings(kernel: &str, spirv: &[u32], layout: &[super::BindingSlot]) -> Result<(), String> {
     for (i, slot) in layout.iter().enumerate() {
-        if layout[..i].iter().any(|s| s.binding == slot.binding || s.block == slot.block) {
+        if layout[..i]
+            .iter()
+            .any(|s| (s.set == slot.set && s.binding == slot.binding) || s.block == slot.block)
+        {
             return Err(format!(
-                "kernel {kernel}: the host layout declares binding {} ({}) twice",
-                slot.binding, slot.block
+                "kernel {kernel}: the host layout declares binding {} ({}) of set {} twice",
+                slot.binding, slot.block, slot.set
             ));
         }
     }
     for found in reflect_bindings(spirv) {
-        if found.set != 0 {
+        let Some(slot) = layout.iter().find(|s| s.set == found.set && s.binding == found.binding) else {
             return Err(format!(
-                "kernel {kernel}: block {} is in descriptor set {}; kernels use set 0 only",
-                found.block, found.set
-            ));
-        }
-        let Some(slot) = layout.iter().find(|s| s.binding == found.binding) else {
-            return Err(format!(
-                "kernel {kernel}: the shader declares binding {} ({}), the host layout does not",
-                found.binding, found.block
+                "kernel {kernel}: the shader declares binding {} ({}) of set {}, the host layout does not",
+                found.binding, found.block, found.set
             ));
         };
         if slot.block != found.block || slot.kind != found.kind {
             return Err(format!(
-                "kernel {kernel}: binding {} is {} ({:?}) in the shader but {} ({:?}) in the host layout",
-                found.binding, found.block, found.kind, slot.block, slot.kind
+                "kernel {kernel}: binding {} is {} ({:?}) in the shader but {} ({:?}) in the host layout (set {})",
+                found.binding, found.block, found.kind, slot.block, slot.kind, found.set
             ));
         }
     }

@@ -106,6 +106,8 @@ fn random_scene_full(
     ];
     Scene::build(SceneParts {
         source: "random test scene".into(),
+        surfaces: Vec::new(),
+        textures: Default::default(),
         triangles,
         materials,
         material_names: vec!["grey".into(), "light".into()],

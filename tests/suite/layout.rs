@@ -10,7 +10,7 @@ use restir_pt::gpu_types::{
     BvhNode, Emitter, FrameParams, Material, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface, Triangle,
 };
 use restir_pt::render::{PassKernel, ReuseMis, ShiftKind};
-use restir_pt::shader_interface::{PathTraceBinding, RestirBinding, SceneBinding};
+use restir_pt::shader_interface::{PathTraceBinding, RestirBinding, SceneBinding, SurfaceBinding};
 use restir_pt::shading::path_record::PathRecord;
 use restir_pt::vk::{check_bindings, compile_kernel, reflect_bindings, Binding, BindingSlot};
 
@@ -222,6 +222,51 @@ fn every_kernel_declares_the_bindings_of_the_shader_interface() {
         }
         // Each binding is checked against a kernel that declares it.
         assert!(used.iter().all(|&u| u), "bindings no ReSTIR kernel declares: {used:?}");
+    }
+}
+
+/// A textured scene's kernels declare descriptor set 1 as SurfaceBinding numbers it, and the
+/// start-up check covers that set: two of its blocks swapped, or the set left out of the host
+/// layout, are refused.
+#[test]
+fn textured_scene_kernels_declare_the_surface_set() {
+    let textured = [("SCENE_SURFACE", "1"), ("SCENE_TEXTURES", "1")];
+    let surface = || SurfaceBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let expected: Vec<(u32, u32, String)> = SurfaceBinding::ALL
+        .iter()
+        .map(|b| (1, b.binding(), b.block().to_string()))
+        .collect();
+    let restir = || RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let pathtrace = || PathTraceBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
+    let (spatial, _) = PassKernel::Spatial.source();
+    for (kernel, own) in [
+        ("pathtrace.comp", pathtrace().collect::<Vec<_>>()),
+        (spatial, restir().collect::<Vec<_>>()),
+    ] {
+        let spirv = compile_kernel(kernel, &textured).expect("kernel compiles");
+        let set1: Vec<(u32, u32, String)> = reflect_bindings(&spirv)
+            .into_iter()
+            .filter(|b| b.set != 0)
+            .map(|b| (b.set, b.binding, b.block))
+            .collect();
+        assert_eq!(set1, expected, "{kernel}: set 1 in the SPIR-V");
+        let layout = host_layout(Binding::Storage, own.iter().copied().chain(surface()));
+        check_bindings(kernel, &spirv, &layout).expect("the shader interface's own layout");
+
+        let mut swapped = layout.clone();
+        let at = |block: &str| swapped.iter().position(|s| s.set == 1 && s.block == block).expect("in the layout");
+        let (headers, texels) = (at("TextureHeaders"), at("Texels"));
+        swapped[headers].block = "Texels";
+        swapped[texels].block = "TextureHeaders";
+        let error = check_bindings(kernel, &spirv, &swapped).expect_err("swapped names are refused");
+        assert!(
+            error.contains("binding 2 is TextureHeaders") && error.contains("(set 1)"),
+            "{error}"
+        );
+
+        let set0_only = host_layout(Binding::Storage, own.iter().copied());
+        let error = check_bindings(kernel, &spirv, &set0_only).expect_err("set 1 missing from the host layout");
+        assert!(error.contains("binding 0 (SurfaceAttributes) of set 1"), "{error}");
     }
 }
 

@@ -34,5 +34,7 @@ mod shift_oracle;
 mod specular_layer;
 mod speed_accuracy;
 mod statistics;
+mod surface_oracle;
 mod sweeps;
+mod textured_scenes;
 mod trace_pair_oracle;

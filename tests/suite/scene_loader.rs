@@ -133,20 +133,31 @@ fn loader_reads_environment_and_rejects_bad_values() {
 
 #[test]
 fn loader_warns_about_textures_and_rejects_unsupported_required_extensions() {
+    // A texture the renderer does not read is reported and its image never opened (it is
+    // missing here); one it reads (base colour, docs/textures.md) must decode.
     let path = scene_file("texture.gltf", floor(), Some(lamp()), |v| {
         v["images"] = json!([{ "uri": "missing.png" }]);
         v["textures"] = json!([{ "source": 0 }]);
-        v["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+        v["extensionsUsed"] = json!(["KHR_materials_transmission"]);
+        v["materials"][0]["extensions"] =
+            json!({ "KHR_materials_transmission": { "transmissionFactor": 0.5, "transmissionTexture": { "index": 0 } } });
     });
     let scene = load_scene(&path).unwrap();
     assert!(
         scene
             .warnings
             .iter()
-            .any(|w| w.contains("texture.gltf") && w.contains("base colour texture ignored")),
+            .any(|w| w.contains("texture.gltf") && w.contains("transmission texture ignored")),
         "{:?}",
         scene.warnings
     );
+    let path = scene_file("missing-image.gltf", floor(), Some(lamp()), |v| {
+        v["images"] = json!([{ "uri": "missing.png" }]);
+        v["textures"] = json!([{ "source": 0 }]);
+        v["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+    });
+    let e = load_error(&path);
+    assert!(e.contains("missing-image.gltf") && e.contains("image 0: cannot decode"), "{e}");
     let path = scene_file("required.gltf", floor(), Some(lamp()), |v| {
         v["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
         v["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);

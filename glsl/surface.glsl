@@ -1,0 +1,62 @@
+// The surface at a hit: interpolated shading normal, tangent frame and texture coordinates.
+// Expects the scene bindings. Twin: src/surface.rs.
+#ifndef SURFACE_GLSL
+#define SURFACE_GLSL
+
+#include "sampling.glsl"
+#include "surface_bindings.glsl"
+#include "types.glsl"
+
+struct SurfaceHit {
+    vec3 normal;        // unit, interpolated (the face normal where there is none); not flipped
+    vec3 tangent;       // unit, orthogonal to normal
+    float handedness;   // ±1: bitangent = handedness * cross(normal, tangent)
+    vec2 uv0;
+    vec2 uv1;
+};
+
+const float SURFACE_MIN_LENGTH_SQUARED = 1e-12;
+
+// Barycentrics (b1, b2) of point p (on or near the triangle's plane) in tri: the least-squares
+// solution of p - v0 = b1 e1 + b2 e2.
+vec2 triangle_bary(Triangle tri, vec3 p) {
+    vec3 d = p - tri.v0;
+    float d00 = dot(tri.e1, tri.e1), d01 = dot(tri.e1, tri.e2), d11 = dot(tri.e2, tri.e2);
+    float d20 = dot(d, tri.e1), d21 = dot(d, tri.e2);
+    float inv = 1.0 / (d00 * d11 - d01 * d01);
+    return vec2(d11 * d20 - d01 * d21, d00 * d21 - d01 * d20) * inv;
+}
+
+// The surface of triangle index `triangle` at barycentrics (b1, b2) of v0 + e1 and v0 + e2.
+SurfaceHit surface_at(uint triangle, vec2 bary) {
+    Triangle tri = triangles[triangle];
+    SurfaceHit s;
+    s.uv0 = vec2(0.0);
+    s.uv1 = vec2(0.0);
+    s.handedness = 1.0;
+#if SCENE_SURFACE
+    vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
+    TriangleSurface a = surface_attributes[triangle];
+    vec3 n = (a.normal[0] * w.x + a.normal[1] * w.y + a.normal[2] * w.z).xyz;
+    s.normal = dot(n, n) > SURFACE_MIN_LENGTH_SQUARED ? normalize(n) : normalize(cross(tri.e1, tri.e2));
+    vec4 t4 = a.tangent[0] * w.x + a.tangent[1] * w.y + a.tangent[2] * w.z;
+    vec3 t = t4.xyz - s.normal * dot(s.normal, t4.xyz);
+    vec3 b;
+    if (dot(t, t) > SURFACE_MIN_LENGTH_SQUARED) {
+        s.tangent = normalize(t);
+    } else {
+        build_onb(s.normal, s.tangent, b);
+    }
+    s.handedness = t4.w < 0.0 ? -1.0 : 1.0;
+    vec4 uv = a.uv[0] * w.x + a.uv[1] * w.y + a.uv[2] * w.z;
+    s.uv0 = uv.xy;
+    s.uv1 = uv.zw;
+#else
+    vec3 b;
+    s.normal = normalize(cross(tri.e1, tri.e2));
+    build_onb(s.normal, s.tangent, b);
+#endif
+    return s;
+}
+
+#endif

@@ -1,0 +1,59 @@
+//! What a hit on the scene sees: its surface (src/surface.rs) and its material with textures
+//! applied (src/texture.rs). Host counterparts of `surface_at`, `material_at` and
+//! `normal_mapped` in glsl/surface.glsl and glsl/texture.glsl.
+
+use glam::{Vec2, Vec3};
+
+use super::Scene;
+use crate::gpu_types::Material;
+use crate::shading::surface::{surface_at, SurfaceHit, TriangleSurface};
+use crate::shading::texture::{normal_mapped, textured_material};
+
+impl Scene {
+    /// The surface of triangle `triangle` at barycentrics `bary` (flat where the scene has no
+    /// attributes).
+    pub fn surface_at(&self, triangle: u32, bary: Vec2) -> SurfaceHit {
+        let flat = TriangleSurface::flat();
+        let attr = self.surfaces.get(triangle as usize).unwrap_or(&flat);
+        surface_at(&self.triangles[triangle as usize], attr, bary)
+    }
+
+    /// The material of triangle `triangle` at barycentrics `bary`, its textures applied.
+    pub fn material_at(&self, triangle: u32, bary: Vec2) -> Material {
+        let index = self.triangles[triangle as usize].material as usize;
+        let m = &self.materials[index];
+        if self.textures.is_empty() || self.surfaces.is_empty() {
+            return *m;
+        }
+        textured_material(m, &self.textures.materials[index], &self.textures, &self.surface_at(triangle, bary))
+    }
+
+    /// The shading normal of triangle `triangle` at `bary`: the interpolated vertex normal with
+    /// its material's normal map applied.
+    pub fn shading_normal(&self, triangle: u32, bary: Vec2) -> Vec3 {
+        let s = self.surface_at(triangle, bary);
+        if self.textures.is_empty() || self.surfaces.is_empty() {
+            return s.normal;
+        }
+        let index = self.triangles[triangle as usize].material as usize;
+        normal_mapped(&self.textures.materials[index], &self.textures, &s)
+    }
+
+    /// One line on the vertex attributes and textures and the device memory they take, or
+    /// `None` for a scene without them.
+    pub fn surface_summary(&self) -> Option<String> {
+        if self.surfaces.is_empty() {
+            return None;
+        }
+        let mib = |bytes: usize| bytes as f64 / (1024.0 * 1024.0);
+        let attributes = mib(std::mem::size_of_val(self.surfaces.as_slice()));
+        let t = &self.textures;
+        let sizes: Vec<String> = t.headers.iter().map(|h| format!("{}x{}", h.width, h.height)).collect();
+        Some(format!(
+            "surface: vertex attributes {attributes:.2} MiB; {} texture(s) [{}] {:.2} MiB (RGBA8 texels in a storage buffer, no mipmaps)",
+            t.headers.len(),
+            sizes.join(", "),
+            mib(t.gpu_bytes())
+        ))
+    }
+}

@@ -1,0 +1,273 @@
+//! GLSL surface.glsl and texture.glsl against src/surface.rs and src/texture.rs: surface_at,
+//! triangle_bary, texture_lookup, texture_coordinates, textured_material and normal_mapped on a
+//! scene of random triangles with random vertex attributes and small random textures (every
+//! address mode, bilinear and nearest, sRGB and linear, KHR_texture_transform rows).
+
+use glam::{Vec2, Vec3, Vec4};
+use restir_pt::gpu_types::{FrameParams, Material, Triangle, NO_EMITTER};
+use restir_pt::render::SceneGpu;
+use restir_pt::scene::{Camera, Scene, SceneParts};
+use restir_pt::shader_interface::SurfaceBinding;
+use restir_pt::shading::surface::{surface_at, triangle_bary, TriangleSurface};
+use restir_pt::shading::texture::{
+    normal_mapped, texture_coordinates, texture_lookup, textured_material, MaterialTextures, SceneTextures, TextureHeader, TextureSlot,
+    NO_TEXTURE, TEXTURE_NEAREST,
+};
+use restir_pt::vk::{Binding, BindingSlot, Buffer, BufferUsage, Kernel};
+
+use crate::common::{assert_clean, assert_vec3_close, close, gpu, TestRng, NAN_FILL};
+
+const ITEMS: usize = 20_000;
+const TEXTURES: usize = 9;
+const MATERIALS: usize = 7;
+/// Relative agreement; sRGB decoding goes through llvmpipe's pow.
+const TOL: f32 = 2e-4;
+
+fn random_textures(r: &mut TestRng) -> SceneTextures {
+    let mut t = SceneTextures::default();
+    for k in 0..TEXTURES {
+        let (w, h) = (1 + (r.uniform() * 9.0) as u32, 1 + (r.uniform() * 9.0) as u32);
+        // Every wrap pair, filter and a few sizes of 1 (where every mode is constant).
+        let sampler_bits = (k as u32 % 3) | (((k as u32 / 3) % 3) << 2) | if r.uniform() < 0.4 { TEXTURE_NEAREST } else { 0 };
+        t.headers.push(TextureHeader {
+            width: w,
+            height: h,
+            offset: t.texels.len() as u32,
+            sampler_bits,
+        });
+        t.texels.extend((0..w * h).map(|_| r.next_u64() as u32));
+    }
+    let slot = |r: &mut TestRng| {
+        if r.uniform() < 0.2 {
+            return TextureSlot::default();
+        }
+        let (u_row, v_row) = restir_pt::shading::texture::texture_transform_rows(
+            [r.uniform() - 0.5, r.uniform() - 0.5],
+            (r.uniform() - 0.5) * 6.0,
+            [0.2 + 2.0 * r.uniform(), 0.2 + 2.0 * r.uniform()],
+        );
+        TextureSlot {
+            u_row,
+            texture_index: (r.uniform() * TEXTURES as f32) as u32 % TEXTURES as u32,
+            v_row,
+            texcoord: (r.uniform() < 0.5) as u32,
+        }
+    };
+    for _ in 0..MATERIALS {
+        let m = MaterialTextures {
+            base_color: slot(r),
+            metal_rough: slot(r),
+            emissive: slot(r),
+            normal: slot(r),
+            normal_scale: 2.0 * r.uniform() - 0.5,
+            alpha_cutoff: 0.5,
+            alpha_mode: 0,
+            base_alpha: 1.0,
+        };
+        t.materials.push(m);
+    }
+    t
+}
+
+fn random_attributes(r: &mut TestRng) -> TriangleSurface {
+    let mut a = TriangleSurface::flat();
+    for k in 0..3 {
+        if r.uniform() < 0.9 {
+            a.normal[k] = r.unit_vector().extend(0.0).to_array();
+        }
+        if r.uniform() < 0.9 {
+            a.tangent[k] = r.unit_vector().extend(if r.uniform() < 0.5 { -1.0 } else { 1.0 }).to_array();
+        }
+        a.uv[k] = [0, 1, 2, 3].map(|_| 6.0 * r.uniform() - 3.0);
+    }
+    a
+}
+
+pub fn textured_random_scene(seed: u64) -> Scene {
+    let mut r = TestRng(seed);
+    let mut triangles = Vec::new();
+    let mut surfaces = Vec::new();
+    for i in 0..500 {
+        let c = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
+        let v: Vec<Vec3> = (0..3).map(|_| c + (0.1 + r.uniform()) * r.unit_vector()).collect();
+        triangles.push(Triangle {
+            v0: v[0].into(),
+            material: i % MATERIALS as u32,
+            e1: (v[1] - v[0]).into(),
+            emitter: NO_EMITTER,
+            e2: (v[2] - v[0]).into(),
+            pad: 0,
+        });
+        surfaces.push(random_attributes(&mut r));
+    }
+    let materials = (0..MATERIALS)
+        .map(|_| Material {
+            base_color: [r.uniform(), r.uniform(), r.uniform()],
+            metallic: r.uniform(),
+            emission: [r.uniform(), r.uniform(), r.uniform()],
+            roughness: r.uniform(),
+            ior: 1.5,
+            ..Default::default()
+        })
+        .collect();
+    Scene::build(SceneParts {
+        source: "random textured scene".into(),
+        triangles,
+        surfaces,
+        textures: random_textures(&mut r),
+        materials,
+        material_names: (0..MATERIALS).map(|i| format!("m{i}")).collect(),
+        environment: Vec3::ONE,
+        environment_map: None,
+        cameras: vec![Camera::look_at("test", Vec3::new(0.0, 1.0, 12.0), Vec3::ZERO, Vec3::Y, 0.8)],
+        lights: vec![],
+        warnings: vec![],
+    })
+}
+
+/// Whether a nearest lookup of `uv` sits within a small margin of a texel edge, where the
+/// GPU's rounding may pick the neighbour.
+fn near_texel_edge(h: &TextureHeader, uv: Vec2) -> bool {
+    let x = uv * Vec2::new(h.width as f32, h.height as f32);
+    let d = (x - x.round()).abs();
+    h.sampler_bits & TEXTURE_NEAREST != 0 && d.min_element() < 1e-3
+}
+
+#[test]
+fn surface_at_texture_lookup_textured_material_normal_mapped_glsl_matches_rust() {
+    compare_surfaces(&textured_random_scene(7));
+}
+
+/// The same comparison on the public Avocado sample: three 2048x2048 textures (48 MiB of
+/// texels), vertex normals and tangents from the file.
+#[test]
+fn surface_oracle_on_the_avocado_sample() {
+    let path = crate::common::repo_path("../shared/assets/Avocado/Avocado.gltf");
+    if !path.exists() {
+        eprintln!("skipped: {} is absent", path.display());
+        return;
+    }
+    let scene = restir_pt::scene::load_scene(&path).unwrap();
+    assert_eq!(scene.textures.headers.len(), 3);
+    compare_surfaces(&scene);
+}
+
+/// Runs surface_oracle.comp over random hits of `scene` and compares each output with its
+/// Rust twin.
+fn compare_surfaces(scene: &Scene) {
+    let ctx = gpu();
+    let textures = scene.textures.headers.len();
+    let scene_gpu = SceneGpu::upload(&ctx, scene).unwrap();
+    let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
+    assert_eq!(surface.buffers.len(), 4, "attributes and three texture buffers");
+    let params = Buffer::new(&ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
+    params.write(&[FrameParams::default()]).unwrap();
+    let mut r = TestRng(11);
+    let mut inputs: Vec<Vec4> = Vec::with_capacity(3 * ITEMS);
+    for _ in 0..ITEMS {
+        let tri = (r.uniform() * scene.triangles.len() as f32) as u32 % scene.triangles.len() as u32;
+        let b = restir_pt::shading::sampling::sample_triangle(Vec2::new(r.uniform(), r.uniform()));
+        let texture = (r.uniform() * textures as f32) as u32 % textures as u32;
+        let t = &scene.triangles[tri as usize];
+        let p = Vec3::from(t.v0) + b.x * Vec3::from(t.e1) + b.y * Vec3::from(t.e2);
+        inputs.push(Vec4::new(f32::from_bits(tri), b.x, b.y, f32::from_bits(texture)));
+        inputs.push(Vec4::new(
+            10.0 * r.uniform() - 5.0,
+            10.0 * r.uniform() - 5.0,
+            (r.uniform() < 0.5) as u32 as f32,
+            0.0,
+        ));
+        inputs.push(p.extend(0.0));
+    }
+    let input = Buffer::from_slice(&ctx, "inputs", &inputs).unwrap();
+    let output = Buffer::new(&ctx, "outputs", (ITEMS * 8 * 16) as u64, BufferUsage::Storage).unwrap();
+    output.fill(NAN_FILL).unwrap();
+    // The oracle binds everything in set 0: the surface family at 5-8 (SURFACE_SET 0,
+    // SURFACE_BINDING 5 in surface_oracle.comp), then the inputs and outputs.
+    let surface_slot = |b: SurfaceBinding| b.slot_at(0, 5, Binding::Storage);
+    let mut buffers = scene_gpu.buffers(&params);
+    buffers.extend(
+        SurfaceBinding::ALL
+            .iter()
+            .zip(&surface.buffers)
+            .map(|(&b, buffer)| surface_slot(b).to(buffer)),
+    );
+    buffers.extend([
+        BindingSlot::storage(9, "Inputs").to(&input),
+        BindingSlot::storage(10, "Outputs").to(&output),
+    ]);
+    let mut layout = scene_gpu.bindings();
+    layout.extend(SurfaceBinding::ALL.iter().map(|&b| surface_slot(b)));
+    layout.extend([BindingSlot::storage(9, "Inputs"), BindingSlot::storage(10, "Outputs")]);
+    let kernel = Kernel::new(&ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
+    kernel.bind(&buffers).unwrap();
+    kernel.run_1d(ITEMS as u32, 64, bytemuck::bytes_of(&(ITEMS as u32))).unwrap();
+    let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(ITEMS * 32).unwrap()).to_vec();
+    let t = &scene.textures;
+    let (mut skipped, mut compared) = (0, 0);
+    for i in 0..ITEMS {
+        let (a, b) = (inputs[3 * i], inputs[3 * i + 1]);
+        let tri = a.x.to_bits();
+        let bary = Vec2::new(a.y, a.z);
+        let g = &out[8 * i..8 * i + 8];
+        let s = surface_at(&scene.triangles[tri as usize], &scene.surfaces[tri as usize], bary);
+        assert_vec3_close(format!("surface_at normal, item {i}"), g[0].truncate(), s.normal, TOL);
+        assert_eq!(g[0].w, s.handedness, "surface_at handedness, item {i}");
+        assert_vec3_close(format!("surface_at tangent, item {i}"), g[1].truncate(), s.tangent, TOL);
+        let uv = Vec4::new(s.uv0.x, s.uv0.y, s.uv1.x, s.uv1.y);
+        assert!((g[2] - uv).abs().max_element() < 1e-4, "surface_at uv, item {i}: {} vs {uv}", g[2]);
+        let bary_rust = triangle_bary(&scene.triangles[tri as usize], inputs[3 * i + 2].truncate());
+        assert!(
+            (g[7].truncate().truncate() - bary_rust).abs().max_element() < 1e-3,
+            "triangle_bary, item {i}"
+        );
+        assert!(
+            (bary_rust - bary).abs().max_element() < 1e-3,
+            "triangle_bary recovers the barycentrics, item {i}"
+        );
+
+        let texture = a.w.to_bits();
+        let header = &t.headers[texture as usize];
+        let lookup_uv = Vec2::new(b.x, b.y);
+        let material = scene.triangles[tri as usize].material as usize;
+        let mt = &t.materials[material];
+        let slots = [mt.base_color, mt.metal_rough, mt.emissive, mt.normal];
+        let any_near_edge = near_texel_edge(header, lookup_uv)
+            || slots.iter().any(|sl| {
+                sl.texture_index != NO_TEXTURE && near_texel_edge(&t.headers[sl.texture_index as usize], texture_coordinates(sl, &s))
+            });
+        if any_near_edge {
+            skipped += 1;
+            continue;
+        }
+        compared += 1;
+        let c = texture_lookup(t, texture, lookup_uv, b.z > 0.5);
+        for k in 0..4 {
+            assert!(close(g[3][k], c[k], TOL), "texture_lookup, item {i}: GLSL {} vs Rust {c}", g[3]);
+        }
+        let coords = texture_coordinates(&mt.base_color, &s);
+        assert!(
+            (Vec2::new(g[7].z, g[7].w) - coords).abs().max_element() < 1e-4,
+            "texture_coordinates, item {i}"
+        );
+        let m = textured_material(&scene.materials[material], mt, t, &s);
+        assert_vec3_close(
+            format!("textured_material base colour, item {i}"),
+            g[4].truncate(),
+            m.base_color.into(),
+            TOL,
+        );
+        assert!(close(g[4].w, m.metallic, TOL), "textured_material metallic, item {i}");
+        assert_vec3_close(
+            format!("textured_material emission, item {i}"),
+            g[5].truncate(),
+            m.emission.into(),
+            TOL,
+        );
+        assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
+        assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, &s), 1e-3);
+    }
+    assert!(skipped < ITEMS / 20, "{skipped} of {ITEMS} items near a nearest-filter texel edge");
+    assert!(compared > 0);
+    assert_clean(&ctx);
+}
