@@ -1,6 +1,8 @@
-// The material model (docs/materials.md): a linear blend of a Lambertian lobe, a GGX conductor
-// and a GGX (or smooth) dielectric. All directions point away from the surface; n is the geometric
-// normal as wound. Twin: src/shading/bsdf.rs.
+// The material model (docs/materials.md): a linear blend of a Lambertian lobe under a GGX
+// specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric. All
+// directions point away from the surface. BSDFs evaluate in the shading frame (normal ns); the
+// geometric normal ng (as wound) decides sides (docs/materials.md, "Shading normals").
+// Twin: src/shading/bsdf.rs.
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
 
@@ -18,6 +20,9 @@
 #ifndef BSDF_DIELECTRIC
 #define BSDF_DIELECTRIC 1
 #endif
+#ifndef BSDF_SPECULAR
+#define BSDF_SPECULAR 1
+#endif
 
 // Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes are
 // ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
@@ -32,7 +37,7 @@ bool index_matched(float eta) { return abs(eta - 1.0) <= INDEX_MATCHED_TOLERANCE
 
 const uint LOBE_NONE = 0u;
 const uint LOBE_DIFFUSE = 1u;
-const uint LOBE_CONDUCTOR = 2u;
+const uint LOBE_CONDUCTOR = 2u;   // GGX reflection: the conductor and the non-metal specular layer
 const uint LOBE_DIELECTRIC = 4u;
 const uint LOBE_DELTA = 8u;
 const uint LOBE_TRANSMISSION = 16u;
@@ -103,12 +108,26 @@ bool refract_dir(vec3 w, vec3 m, float eta, out vec3 wt, out float etap) {
     return true;
 }
 
+// The split by metallic and transmission factors: the non-metal (diffuse base and its specular
+// layer), the conductor and the dielectric.
 void lobe_weights(Material m, out float w_diffuse, out float w_conductor, out float w_dielectric) {
     float t = clamp(m.transmission, 0.0, 1.0);
     float k = clamp(m.metallic, 0.0, 1.0);
     w_diffuse = (1.0 - t) * (1.0 - k);
     w_conductor = (1.0 - t) * k;
     w_dielectric = t;
+}
+
+float max_component3(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+// The non-metal's specular-layer Fresnel weight * fr: KHR_materials_specular's fresnel_mix
+// (f0 = min(((ior - 1) / (ior + 1))^2 * specularColor, 1), Schlick) taken at the shading normal,
+// |cos_o|, rather than at wo.h, so that the layer never gains energy (docs/materials.md).
+vec3 specular_layer_fresnel(Material m, float cos_o) {
+    if (BSDF_SPECULAR == 0 || !(m.specular > 0.0)) return vec3(0.0);
+    float r = (m.ior - 1.0) / (m.ior + 1.0);
+    vec3 f0 = min(r * r * m.specular_color, vec3(1.0));
+    return m.specular * fresnel_schlick(f0, abs(cos_o));
 }
 
 // Rough dielectric f*|cos_i| and pdf (local frame; n = +z is the outside).
@@ -154,15 +173,18 @@ void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float
     vec3 wo_s = wo * vec3(1.0, 1.0, side);
     vec3 wi_s = wi * vec3(1.0, 1.0, side);
     bool same_side = wo_s.z > 0.0 && wi_s.z > 0.0;
-    if (BSDF_DIFFUSE != 0 && w_d > 0.0 && same_side) {
-        f_cos += w_d * m.base_color * INV_PI * wi_s.z;
-        pdf += w_d * pdf_cosine_hemisphere(wi_s.z);
+    // The layer's tint and its share of the non-metal's selection probability.
+    vec3 layer = w_d * specular_layer_fresnel(m, wo_s.z);
+    float p_layer = max_component3(layer);
+    if (BSDF_DIFFUSE != 0 && w_d > p_layer && same_side) {
+        f_cos += (w_d - p_layer) * m.base_color * INV_PI * wi_s.z;
+        pdf += (w_d - p_layer) * pdf_cosine_hemisphere(wi_s.z);
     }
-    if (BSDF_CONDUCTOR != 0 && w_c > 0.0 && same_side && alpha >= DELTA_ALPHA) {
+    if ((BSDF_CONDUCTOR != 0 || BSDF_SPECULAR != 0) && w_c + p_layer > 0.0 && same_side && alpha >= DELTA_ALPHA) {
         vec3 h = normalize(wo_s + wi_s);
-        vec3 f = fresnel_schlick(m.base_color, dot(wo_s, h));
-        f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
-        pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
+        vec3 f = w_c * fresnel_schlick(m.base_color, dot(wo_s, h)) + layer;
+        f_cos += f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
+        pdf += (w_c + p_layer) * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
     }
     if (BSDF_DIELECTRIC != 0 && w_t > 0.0 && alpha >= DELTA_ALPHA && !index_matched(m.ior)) {
         float fc, p;
@@ -172,8 +194,23 @@ void bsdf_eval_pdf_local(Material m, vec3 wo, vec3 wi, out vec3 f_cos, out float
     }
 }
 
-// f * |cos_i| of the non-delta lobes, and in `pdf` the solid-angle pdf of bsdf_sample producing wi.
-vec3 bsdf_eval_pdf(Material m, vec3 n, vec3 wo, vec3 wi, out float pdf) {
+// pbrt-v4's orientation (SurfaceInteraction::SetShadingGeometry): the shading normal is turned
+// into the geometric normal's hemisphere.
+vec3 shading_normal_facing(vec3 ng, vec3 ns) { return dot(ns, ng) < 0.0 ? -ns : ns; }
+
+// Mitsuba's strict normals: a direction that lies on different sides of the geometric and the
+// shading normal carries nothing (no light leaks through the surface, no reflection into it).
+bool sides_agree(vec3 ng, vec3 ns, vec3 w) {
+    float a = dot(w, ng), b = dot(w, ns);
+    return (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0);
+}
+
+// f * |cos_i| (the cosine against the shading normal) of the non-delta lobes, and in `pdf` the
+// solid-angle pdf of bsdf_sample producing wi; ng geometric, ns shading normal (unit).
+vec3 bsdf_eval_pdf(Material m, vec3 ng, vec3 ns, vec3 wo, vec3 wi, out float pdf) {
+    vec3 n = shading_normal_facing(ng, ns);
+    pdf = 0.0;
+    if (!sides_agree(ng, n, wo) || !sides_agree(ng, n, wi)) return vec3(0.0);
     vec3 t, b;
     build_onb(n, t, b);
     vec3 f_cos;
@@ -181,8 +218,8 @@ vec3 bsdf_eval_pdf(Material m, vec3 n, vec3 wo, vec3 wi, out float pdf) {
     return f_cos;
 }
 
-// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
-BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
+// bsdf_sample in the frame of normal n alone (no side checks).
+BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
     BsdfSample s;
     s.wi = vec3(0.0);
     s.weight = vec3(0.0);
@@ -197,17 +234,20 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
     float alpha = ggx_alpha(m.roughness);
     float side = wo.z < 0.0 ? -1.0 : 1.0;
     vec3 wo_s = wo * vec3(1.0, 1.0, side);
+    vec3 layer = w_d * specular_layer_fresnel(m, wo_s.z);
+    float p_layer = max_component3(layer);
     vec3 wi;
     uint lobe;
-    if (BSDF_DIFFUSE != 0 && u.z < w_d) {
+    // Lobe choice: diffuse w_d - p_layer, GGX reflection w_c + p_layer, dielectric w_t.
+    if (BSDF_DIFFUSE != 0 && u.z < w_d - p_layer) {
         wi = sample_cosine_hemisphere(u.xy) * vec3(1.0, 1.0, side);
         lobe = LOBE_DIFFUSE;
-    } else if (BSDF_CONDUCTOR != 0 && u.z < w_d + w_c) {
+    } else if ((BSDF_CONDUCTOR != 0 || BSDF_SPECULAR != 0) && u.z < w_d + w_c) {
         lobe = LOBE_CONDUCTOR;
         if (alpha < DELTA_ALPHA) {
             s.wi = to_world(vec3(-wo.x, -wo.y, wo.z), t, b, n);
-            s.weight = fresnel_schlick(m.base_color, wo_s.z);
-            s.pdf = w_c;
+            s.pdf = w_c + p_layer;
+            s.weight = (w_c * fresnel_schlick(m.base_color, wo_s.z) + layer) / s.pdf;
             s.lobe = LOBE_CONDUCTOR | LOBE_DELTA;
             return s;
         }
@@ -269,6 +309,21 @@ BsdfSample bsdf_sample(Material m, vec3 n, vec3 wo_world, vec4 u) {
     s.pdf = pdf;
     s.lobe = lobe;
     return s;
+}
+
+// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice; ng geometric, ns
+// shading normal (unit). A sample on different sides of the two normals fails.
+BsdfSample bsdf_sample(Material m, vec3 ng, vec3 ns, vec3 wo_world, vec4 u) {
+    vec3 n = shading_normal_facing(ng, ns);
+    BsdfSample s;
+    s.wi = vec3(0.0);
+    s.weight = vec3(0.0);
+    s.pdf = 0.0;
+    s.lobe = LOBE_NONE;
+    if (!sides_agree(ng, n, wo_world)) return s;
+    BsdfSample r = bsdf_sample_frame(m, n, wo_world, u);
+    if (r.lobe == LOBE_NONE || !sides_agree(ng, n, r.wi)) return s;
+    return r;
 }
 
 #endif

@@ -100,7 +100,7 @@ bool path_step(inout PathState s) {
     LightSample ls = sample_light(x, ul.xyz);
     if (ls.pdf > 0.0 && max_component(ls.radiance) > 0.0) {
         float bsdf_pdf;
-        vec3 f = bsdf_eval_pdf(m, ng, wo, ls.dir, bsdf_pdf);
+        vec3 f = bsdf_eval_pdf(m, ng, ng, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
             s.shadow = shadow_ray(x, ng, hit.triangle, ls);
             // BSDF sampling never reaches a punctual light: NEE alone estimates it.
@@ -111,7 +111,7 @@ bool path_step(inout PathState s) {
 
     // A path that ends here still traces its pending shadow ray in one more step.
     s.extend = false;
-    BsdfSample bs = bsdf_sample(m, ng, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
+    BsdfSample bs = bsdf_sample(m, ng, ng, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
     if (bs.lobe == LOBE_NONE) return s.shadow.tmax > 0.0;
     s.beta *= bs.weight;
     s.prev_pdf = bs.pdf;

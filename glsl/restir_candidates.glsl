@@ -84,7 +84,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         Vertex light;
         if (nee_vertex(x, seed, i, ls, light)) {
             float bsdf_pdf;
-            vec3 f_cos = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf);
+            vec3 f_cos = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir, bsdf_pdf);
             if (max_component(f_cos) > 0.0 && visible(x, light)) {
                 vec3 weight = f_cos / ls.pdf;
                 // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand (equal

@@ -97,6 +97,8 @@ bool vertex_is_rough(Vertex v, ShiftParams params) {
     Material m = material_of(v);
     float w_d, w_c, w_t;
     lobe_weights(m, w_d, w_c, w_t);
+    // A non-metal's specular layer is a GGX lobe too.
+    if (w_d > 0.0 && m.specular > 0.0) w_c = 1.0;
     bool rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
     return (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)));
 }
@@ -186,7 +188,7 @@ float end_mis_weight(Vertex x, vec3 before, Vertex end, bool nee_end, bool after
     float dist;
     direction(x, end, dir, dist);
     float bsdf_pdf;
-    bsdf_eval_pdf(material_of(x), x.normal, normalize(before - x.pos), dir, bsdf_pdf);
+    bsdf_eval_pdf(material_of(x), x.normal, x.normal, normalize(before - x.pos), dir, bsdf_pdf);
     float light = light_pdf(x, end);
     return nee_end ? balance_heuristic(light, bsdf_pdf) : balance_heuristic(bsdf_pdf, light);
 }
@@ -212,7 +214,7 @@ bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex ligh
 // The BSDF sample at x_i drawn with the path's random numbers and the origin of its ray; false
 // if no lobe was sampled.
 bool bsdf_ray(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out vec3 origin) {
-    s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
+    s = bsdf_sample(m, x.normal, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
     if (s.lobe == LOBE_NONE) return false;
     origin = offset_ray_origin(x.pos, dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal, triangles[x.triangle]);
     return true;
@@ -270,7 +272,7 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
             if (!nee_vertex(x, seed, i, ls, next)) return false;
             float bsdf_pdf;
             lobe = LOBE_NONE;
-            weight = bsdf_eval_pdf(m, x.normal, wo, ls.dir, bsdf_pdf) / ls.pdf;
+            weight = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir, bsdf_pdf) / ls.pdf;
             visibility_ray(x, next, origin, dir, tmax);
         } else {
             BsdfSample s;
@@ -326,7 +328,7 @@ Link reconnection_link(Vertex prev, vec3 before, Vertex x_r, bool nee_at_r) {
     float dist;
     direction(prev, x_r, link.dir, dist);
     float bsdf_pdf;
-    link.f_cos = bsdf_eval_pdf(material_of(prev), prev.normal, normalize(before - prev.pos), link.dir, bsdf_pdf);
+    link.f_cos = bsdf_eval_pdf(material_of(prev), prev.normal, prev.normal, normalize(before - prev.pos), link.dir, bsdf_pdf);
     link.pdf = nee_at_r ? light_pdf(prev, x_r) : bsdf_pdf;
     // A punctual x_r is one fixed point (or direction) whichever predecessor joins it: no
     // solid-angle-to-area factor, so its part of the Jacobian is 1.
@@ -339,7 +341,7 @@ float pdf_after(Vertex x_r, vec3 dir_in, Vertex next, bool next_is_nee, out vec3
     float dist;
     direction(x_r, next, dir_next, dist);
     float pdf;
-    f_cos = bsdf_eval_pdf(material_of(x_r), x_r.normal, -dir_in, dir_next, pdf);
+    f_cos = bsdf_eval_pdf(material_of(x_r), x_r.normal, x_r.normal, -dir_in, dir_next, pdf);
     return next_is_nee ? light_pdf(x_r, next) : pdf;
 }
 

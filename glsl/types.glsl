@@ -12,6 +12,8 @@ struct Material {
     float transmission;
     float ior;
     uint flags;
+    float specular;        // KHR_materials_specular specularFactor; 0: no specular layer on non-metals
+    vec3 specular_color;   // KHR_materials_specular specularColorFactor (linear)
     uint pad;
 };
 const uint MATERIAL_DOUBLE_SIDED = 1u;

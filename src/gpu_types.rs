@@ -15,6 +15,11 @@ pub struct Material {
     pub transmission: f32,
     pub ior: f32,
     pub flags: u32,
+    /// `KHR_materials_specular` specularFactor: the strength of the non-metal specular layer
+    /// (docs/materials.md); 0 makes the non-metal part purely Lambertian.
+    pub specular: f32,
+    /// `KHR_materials_specular` specularColorFactor (linear RGB), scaling the layer's F0.
+    pub specular_color: [f32; 3],
     pub pad: u32,
 }
 

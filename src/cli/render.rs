@@ -366,3 +366,20 @@ fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
         frame += 1;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn render_without_arguments_takes_the_library_defaults() {
+        let args = RenderArgs::parse_defaults().unwrap();
+        assert_eq!((args.method, args.frames, args.static_camera), (MethodArg::Restir, 1, false));
+        assert_eq!(args.path.max_depth, RenderSettings::DEFAULT_MAX_DEPTH);
+        assert_eq!(args.restir_settings(), Some(RestirSettings::default()));
+        assert_eq!(args.russian_roulette, None);
+        let pt: RenderArgs = super::super::parse_args(&["--method", "pt", "--russian-roulette", "off", "--exposure", "-1.5"]).unwrap();
+        assert_eq!((pt.restir_settings(), pt.russian_roulette), (None, Some(Toggle::Off)));
+        assert_eq!(pt.exposure, Exposure::Ev(-1.5));
+    }
+}

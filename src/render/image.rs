@@ -2,10 +2,6 @@
 
 use glam::Vec3;
 
-use super::RenderSettings;
-use crate::error::GpuError;
-use crate::vk::Buffer;
-
 #[derive(Debug, Clone)]
 pub struct Image {
     pub width: u32,
@@ -16,15 +12,6 @@ pub struct Image {
 }
 
 impl Image {
-    /// Reads a renderer's accumulation buffers (vec4 sums of L with counts, and of L^2) back
-    /// into an image.
-    pub fn read_accumulation(settings: &RenderSettings, sums: &Buffer, sums_sq: &Buffer) -> Result<Image, GpuError> {
-        let n = settings.pixel_count();
-        let sums: Vec<[f32; 4]> = sums.read(n)?;
-        let sums_sq: Vec<[f32; 4]> = sums_sq.read(n)?;
-        Ok(Image::from_sums(settings.width, settings.height, &sums, &sums_sq))
-    }
-
     /// From per-pixel sums of L (rgb) and counts (w), and sums of L^2. A pixel no sample reached
     /// is NaN, never a plausible-looking 0.
     pub fn from_sums(width: u32, height: u32, sums: &[[f32; 4]], sums_sq: &[[f32; 4]]) -> Image {

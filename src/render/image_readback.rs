@@ -62,7 +62,10 @@ impl AccumReadback {
             sums_sq.record_copy_to(cmd, &self.image, bytes, bytes);
             record_host_read_barrier(&self.ctx.device, cmd);
         })?;
-        Ok((self.image.read_mapped(0, self.pixels())?, self.image.read_mapped(bytes, self.pixels())?))
+        Ok((
+            self.image.read_mapped(0, self.pixels())?,
+            self.image.read_mapped(bytes, self.pixels())?,
+        ))
     }
 
     /// The image of the accumulation buffers (see `Image::from_sums`).

@@ -3,6 +3,7 @@
 mod counters;
 mod frame_plan;
 mod image;
+mod image_readback;
 mod path_tracer;
 mod reservoir_layers;
 mod restir;

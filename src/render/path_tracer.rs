@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 
 use super::counters::{TraversalCounters, COUNTER_COUNT};
+use super::image_readback::AccumReadback;
 use super::{Image, RenderSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
@@ -51,8 +52,7 @@ impl RenderStats {
     }
 }
 
-/// Per-pixel vec4 accumulations, row-major.
-pub type PixelSums = Vec<[f32; 4]>;
+pub use super::image_readback::PixelSums;
 
 pub struct PathTracer {
     ctx: Arc<Context>,
@@ -61,6 +61,8 @@ pub struct PathTracer {
     accum: Buffer,
     accum_sq: Buffer,
     status: Buffer,
+    /// The image and the dispatch status come back through it.
+    readback: AccumReadback,
     _scene_gpu: SceneGpu,
     timer: PassTimer,
     settings: RenderSettings,
@@ -124,6 +126,7 @@ impl PathTracer {
             accum,
             accum_sq,
             status,
+            readback: AccumReadback::new(ctx, settings.width, settings.height, STATUS_WORDS * 4)?,
             timer: PassTimer::new(ctx, 1)?,
             base_params: settings.frame_params(scene),
             settings: settings.clone(),
@@ -199,9 +202,11 @@ impl PathTracer {
                 self.timer.record_begin(cmd, 0);
                 self.kernel.record_dispatch(cmd, groups, &[]);
                 self.timer.record_end(cmd, 0);
+                record_compute_barrier(&self.ctx.device, cmd);
+                self.readback.record_counters(cmd, &self.status);
             })
             .context("path tracing")?;
-        let status = self.status.read::<u32>(STATUS_WORDS as usize)?;
+        let status = self.readback.counters::<u32>(STATUS_WORDS as usize)?;
         let (iterations, cut_groups, nonfinite) = (status[0], status[1], status[2]);
         if cut_groups > 0 {
             let limit = self.ctx.info.loop_iteration_limit.unwrap_or(0);
@@ -281,11 +286,11 @@ impl PathTracer {
     /// The accumulation buffers as they are: per pixel `[sum r, sum g, sum b, samples]` and
     /// `[sum r^2, sum g^2, sum b^2, 0]` of the radiance of its paths, row-major.
     pub fn sums(&self) -> Result<(PixelSums, PixelSums)> {
-        let n = self.settings.pixel_count();
-        Ok((self.accum.read(n)?, self.accum_sq.read(n)?))
+        Ok(self.readback.sums(&self.accum, &self.accum_sq)?)
     }
 
+    /// The mean of the samples so far, with its variance.
     pub fn image(&self) -> Result<Image> {
-        Ok(Image::read_accumulation(&self.settings, &self.accum, &self.accum_sq)?)
+        Ok(self.readback.image(&self.accum, &self.accum_sq)?)
     }
 }

@@ -1,21 +1,28 @@
 //! The ReSTIR PT renderer: per frame, initial candidates, temporal reuse, spatial rounds and
 //! shading (glsl/restir_*.comp) in one submission, with reservoirs in storage buffers. Which
-//! passes run is planned in frame_plan.rs.
+//! passes run is planned in frame_plan.rs (a pure function), recorded in restir/record.rs.
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 
-use super::frame_plan::{pass_table, plan_frame, FramePlan, FrameState, PassKernel, PASS_NAMES};
+use self::buffers::RestirBuffers;
+use self::params::same_pose;
+use super::frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PASS_NAMES};
+use super::image_readback::AccumReadback;
 use super::reservoir_layers::ReservoirLayers;
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
-use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
+use crate::gpu_types::{FrameParams, RestirStats, ReuseParams};
 use crate::scene::Scene;
 use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
-use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
+use crate::vk::{Binding, Context, Kernel, KernelCompile, PassTimer};
+
+mod buffers;
+mod params;
+mod record;
 
 const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
@@ -52,15 +59,9 @@ pub struct Restir {
     ctx: Arc<Context>,
     /// The frame's kernels, indexed by `PassKernel as usize`.
     kernels: Vec<Kernel>,
-    params: Buffer,
-    reuse: Buffer,
-    /// Each pixel's surface (glsl/restir_bindings.glsl), this frame's and the previous one's,
-    /// shared by the pixel's reservoirs.
-    surfaces: [Buffer; 2],
-    layers: ReservoirLayers,
-    accum: Buffer,
-    accum_sq: Buffer,
-    stats: Buffer,
+    buffers: RestirBuffers,
+    /// The image and the per-frame counters come back through it.
+    readback: AccumReadback,
     scene_gpu: SceneGpu,
     timer: PassTimer,
     settings: RenderSettings,
@@ -96,47 +97,14 @@ impl Restir {
                 ctx.info.max_compute_shared_memory
             );
         }
-        let pixels = settings.pixel_count() as u64;
-        ctx.check_binding_size("the accumulation image", pixels * 16)?;
-        let surface_bytes = pixels * std::mem::size_of::<Surface>() as u64;
-        ctx.check_binding_size("the surfaces", surface_bytes)?;
-        let layers = ReservoirLayers::new(ctx, pixels, restir.reservoirs)?;
+        let buffers = RestirBuffers::new(ctx, settings.pixel_count() as u64, restir.reservoirs)?;
         let scene_gpu = SceneGpu::upload(ctx, scene)?;
-        let storage = |name: &str, bytes: u64| Buffer::new(ctx, name, bytes, BufferUsage::Storage);
-        let params_buffer = |name: &str, bytes: usize| Buffer::new(ctx, name, bytes as u64, BufferUsage::Params);
-        let params = params_buffer("frame parameters", std::mem::size_of::<FrameParams>())?;
-        let reuse = params_buffer("reuse parameters", std::mem::size_of::<ReuseParams>())?;
-        let surfaces = [storage("surfaces 0", surface_bytes)?, storage("surfaces 1", surface_bytes)?];
-        let accum = storage("accumulation", pixels * 16)?;
-        let accum_sq = storage("accumulation of squares", pixels * 16)?;
-        let stats = storage("ReSTIR statistics", std::mem::size_of::<RestirStats>() as u64)?;
-
-        let mut bindings = scene_gpu.bindings();
-        bindings.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
-        let mut defines = scene_gpu.defines();
-        defines.extend(restir.defines());
-        let mut kernels = Vec::with_capacity(PassKernel::ALL.len());
-        for kernel in PassKernel::ALL {
-            let (file, extra) = kernel.source();
-            let all: Vec<_> = defines.iter().chain(extra).copied().collect();
-            let mut k = Kernel::new(ctx, file, &all, &bindings, 4)?;
-            if kernel == PassKernel::TemporalUnmoved {
-                k.set_variant("(unmoved camera)");
-            }
-            kernels.push(k);
-        }
-        accum.fill(0)?;
-        accum_sq.fill(0)?;
-        let mut restir = Self {
+        let stats_bytes = std::mem::size_of::<RestirStats>() as u64;
+        let mut renderer = Self {
             ctx: ctx.clone(),
-            kernels,
-            params,
-            reuse,
-            surfaces,
-            layers,
-            accum,
-            accum_sq,
-            stats,
+            kernels: build_kernels(ctx, &scene_gpu, restir)?,
+            buffers,
+            readback: AccumReadback::new(ctx, settings.width, settings.height, stats_bytes)?,
             scene_gpu,
             timer: PassTimer::new(ctx, PASS_NAMES.len() as u32)?,
             settings: settings.clone(),
@@ -146,9 +114,9 @@ impl Restir {
             history: None,
             surface_slot: 0,
         };
-        restir.bind_buffers()?;
-        restir.warm_up(progress)?;
-        Ok(restir)
+        renderer.bind_buffers()?;
+        renderer.warm_up(progress)?;
+        Ok(renderer)
     }
 
     /// Dispatches every kernel once over an image of zero pixels, which writes nothing: llvmpipe
@@ -160,8 +128,8 @@ impl Restir {
             height: 0,
             ..Default::default()
         };
-        self.params.write(std::slice::from_ref(&empty))?;
-        self.reuse.write(std::slice::from_ref(&ReuseParams::default()))?;
+        self.buffers.params.write(std::slice::from_ref(&empty))?;
+        self.buffers.reuse.write(std::slice::from_ref(&ReuseParams::default()))?;
         for kernel in &mut self.kernels {
             progress(&kernel.compile_report().name);
             kernel
@@ -181,29 +149,11 @@ impl Restir {
         self.kernels.iter().map(|k| k.compile_report().total_ms()).sum()
     }
 
-    /// Points every kernel's descriptors at the current buffers.
+    /// Points every kernel's descriptors at the current buffers, by binding name.
     fn bind_buffers(&self) -> Result<()> {
-        use RestirBinding as B;
-        let layers = &self.layers;
-        let mut buffers = self.scene_gpu.buffers(&self.params);
-        buffers.extend([
-            B::ReuseParams.to(&self.reuse),
-            B::Surfaces0.to(&self.surfaces[0]),
-            B::Surfaces1.to(&self.surfaces[1]),
-        ]);
-        for (slot, (heads, tails)) in layers.heads.iter().zip(&layers.tails).enumerate() {
-            let (head_binding, tail_binding) = B::reservoir_slot(slot);
-            buffers.extend([head_binding.to(heads), tail_binding.to(tails)]);
-        }
-        buffers.extend([
-            B::Direct.to(&layers.direct),
-            B::Accum.to(&self.accum),
-            B::AccumSq.to(&self.accum_sq),
-            B::RestirStats.to(&self.stats),
-            B::Expectation.to(&layers.expectation),
-        ]);
+        let table = self.buffers.binding_table(&self.scene_gpu);
         for kernel in &self.kernels {
-            kernel.bind(&buffers)?;
+            kernel.bind(&table)?;
         }
         Ok(())
     }
@@ -211,8 +161,8 @@ impl Restir {
     /// Forgets the temporal history and the accumulated average; the next frame starts a new,
     /// independent chain with seed `seed`.
     pub fn reset(&mut self, seed: u32) -> Result<()> {
-        self.accum.fill(0)?;
-        self.accum_sq.fill(0)?;
+        self.buffers.accum.fill(0)?;
+        self.buffers.accum_sq.fill(0)?;
         self.history = None;
         self.frame_index = 0;
         self.settings.seed = seed;
@@ -228,7 +178,7 @@ impl Restir {
         };
         restir.validate(self.settings.max_depth)?;
         if reservoirs != self.restir.reservoirs {
-            self.layers = ReservoirLayers::new(&self.ctx, self.settings.pixel_count() as u64, reservoirs)?;
+            self.buffers.layers = ReservoirLayers::new(&self.ctx, self.settings.pixel_count() as u64, reservoirs)?;
             self.bind_buffers()?;
             self.history = None;
         }
@@ -236,35 +186,9 @@ impl Restir {
         Ok(())
     }
 
-    /// The reuse parameters of a frame seen from `frame` after `prev`, with its pass table.
-    fn reuse_params(&self, prev: &FrameParams, frame: &FrameParams, plan: &FramePlan, accumulate: bool) -> ReuseParams {
-        let temporal_valid = self.restir.temporal && self.history.is_some();
-        ReuseParams {
-            prev_cam_position: prev.cam_position,
-            prev_cam_right: prev.cam_right,
-            prev_cam_up: prev.cam_up,
-            prev_cam_forward: prev.cam_forward,
-            roughness_threshold: self.shift_params.roughness_threshold,
-            distance_threshold: self.shift_params.distance_threshold,
-            m_cap: self.restir.m_cap,
-            radius: self.restir.radius,
-            normal_threshold: self.restir.normal_threshold,
-            depth_threshold: self.restir.depth_threshold,
-            frame_index: self.frame_index,
-            candidates: self.restir.candidates,
-            neighbours: self.restir.spatial,
-            temporal_valid: temporal_valid as u32,
-            emission_rays: self.restir.emission_rays,
-            reservoirs: self.restir.reservoirs,
-            // Frames being accumulated are averaged already; a running mean inside them would
-            // only weigh the early frames' rays more.
-            emission_history: (temporal_valid && same_pose(prev, frame) && !accumulate) as u32,
-            passes: pass_table(plan),
-        }
-    }
-
-    /// Renders one frame from the scene's camera `camera`. With `accumulate` the frame is added
-    /// to the running average (a static camera's offline mode); otherwise the average restarts.
+    /// Renders one frame from the scene's camera `camera`, in one submission. With
+    /// `accumulate` the frame is added to the running average (a static camera's offline
+    /// mode); otherwise the average restarts.
     pub fn frame(&mut self, scene: &Scene, camera: usize, accumulate: bool) -> Result<FrameStats> {
         let start = Instant::now();
         let settings = RenderSettings {
@@ -273,30 +197,12 @@ impl Restir {
         };
         settings.validate(scene)?;
         let frame_params = settings.frame_params(scene);
-        let prev = self.history.map(|(_, p)| p).unwrap_or(frame_params);
-        let plan = plan_frame(&FrameState {
-            history_slot: self.history.map(|(s, _)| s),
-            temporal: self.restir.temporal,
-            unmoved: same_pose(&prev, &frame_params),
-            surface_slot: self.surface_slot,
-            spatial_rounds: self.restir.spatial_rounds(),
-            history: self.restir.history,
-        });
-        self.params.write(std::slice::from_ref(&frame_params))?;
-        let reuse = self.reuse_params(&prev, &frame_params, &plan, accumulate);
-        self.reuse.write(std::slice::from_ref(&reuse))?;
+        let plan = self.plan(&frame_params);
+        self.write_params(&frame_params, &plan, accumulate)?;
         self.ctx
             .submit_and_wait(|cmd| self.record_frame(cmd, &plan, accumulate))
             .context("ReSTIR PT frame")?;
-        let counters = self.stats.read::<RestirStats>(1)?[0];
-        if counters.loop_budget_cut_groups > 0 {
-            return Err(GpuError::LoopLimit {
-                limit: self.ctx.info.loop_iteration_limit.unwrap_or(0),
-                counted: counters.max_loop_iterations,
-                groups: counters.loop_budget_cut_groups,
-            }
-            .into());
-        }
+        let counters = self.read_counters()?;
         let pass_ms = self.timer.read_ms(PASS_NAMES.len() as u32)?.map(|t| [t[0], t[1], t[2], t[3]]);
         self.history = Some((plan.final_slot, frame_params));
         self.surface_slot = 1 - self.surface_slot;
@@ -308,59 +214,64 @@ impl Restir {
         })
     }
 
-    /// Records a frame's dispatches; each pass's push constant is its index in the pass table.
-    /// Every pass but shading runs once per reservoir (the z dimension); shading averages a
-    /// pixel's reservoirs.
-    fn record_frame(&self, cmd: ash::vk::CommandBuffer, plan: &FramePlan, accumulate: bool) {
-        self.stats.record_fill(cmd, 0);
-        if !accumulate {
-            self.accum.record_fill(cmd, 0);
-            self.accum_sq.record_fill(cmd, 0);
-        }
-        record_compute_barrier(&self.ctx.device, cmd);
-        self.timer.record_reset(cmd);
-        let mut open: Option<usize> = None;
-        for (index, pass) in plan.passes.iter().enumerate() {
-            let slot = pass.kernel.timer_slot();
-            if open != Some(slot) {
-                if let Some(s) = open {
-                    self.timer.record_end(cmd, s as u32);
-                }
-                self.timer.record_begin(cmd, slot as u32);
-                open = Some(slot);
+    /// The passes of a frame from `frame` after the history (see frame_plan.rs).
+    fn plan(&self, frame: &FrameParams) -> FramePlan {
+        let prev = self.history.map(|(_, p)| p).unwrap_or(*frame);
+        plan_frame(&FrameState {
+            history_slot: self.history.map(|(s, _)| s),
+            temporal: self.restir.temporal,
+            unmoved: same_pose(&prev, frame),
+            surface_slot: self.surface_slot,
+            spatial_rounds: self.restir.spatial_rounds(),
+            history: self.restir.history,
+        })
+    }
+
+    /// Writes the frame and reuse parameters of the planned frame.
+    fn write_params(&self, frame: &FrameParams, plan: &FramePlan, accumulate: bool) -> Result<()> {
+        let prev = self.history.map(|(_, p)| p).unwrap_or(*frame);
+        self.buffers.params.write(std::slice::from_ref(frame))?;
+        let reuse = self.reuse_params(&prev, frame, plan, accumulate);
+        self.buffers.reuse.write(std::slice::from_ref(&reuse))?;
+        Ok(())
+    }
+
+    /// The frame's counters; a frame whose loops ran out of the driver's budget is an error.
+    fn read_counters(&self) -> Result<RestirStats> {
+        let counters = self.readback.counters::<RestirStats>(1)?[0];
+        if counters.loop_budget_cut_groups > 0 {
+            return Err(GpuError::LoopLimit {
+                limit: self.ctx.info.loop_iteration_limit.unwrap_or(0),
+                counted: counters.max_loop_iterations,
+                groups: counters.loop_budget_cut_groups,
             }
-            let layers = if pass.kernel == PassKernel::Shade {
-                1
-            } else {
-                self.restir.reservoirs
-            };
-            let groups = [
-                self.settings.width.div_ceil(LOCAL_SIZE),
-                self.settings.height.div_ceil(LOCAL_SIZE),
-                layers,
-            ];
-            self.kernels[pass.kernel as usize].record_dispatch(cmd, groups, &(index as u32).to_ne_bytes());
-            record_compute_barrier(&self.ctx.device, cmd);
+            .into());
         }
-        if let Some(s) = open {
-            self.timer.record_end(cmd, s as u32);
-        }
-        // Passes that did not run this frame get an empty interval.
-        for slot in 0..PASS_NAMES.len() {
-            if !plan.passes.iter().any(|p| p.kernel.timer_slot() == slot) {
-                self.timer.record_begin(cmd, slot as u32);
-                self.timer.record_end(cmd, slot as u32);
-            }
-        }
+        Ok(counters)
     }
 
     /// The average of the frames accumulated since the last restart.
     pub fn image(&self) -> Result<Image> {
-        Ok(Image::read_accumulation(&self.settings, &self.accum, &self.accum_sq)?)
+        Ok(self.readback.image(&self.buffers.accum, &self.buffers.accum_sq)?)
     }
 }
 
-/// Whether two frames share a camera pose, compared as glsl/restir_reuse.glsl's same_pose does.
-fn same_pose(a: &FrameParams, b: &FrameParams) -> bool {
-    a.cam_position == b.cam_position && a.cam_right == b.cam_right && a.cam_up == b.cam_up && a.cam_forward == b.cam_forward
+/// Every kernel a frame may run, indexed by `PassKernel as usize`, built for the scene's
+/// bindings and defines and for the shift and MIS of `restir`.
+fn build_kernels(ctx: &Arc<Context>, scene_gpu: &SceneGpu, restir: &RestirSettings) -> Result<Vec<Kernel>> {
+    let mut layout = scene_gpu.bindings();
+    layout.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
+    let mut defines = scene_gpu.defines();
+    defines.extend(restir.defines());
+    let mut kernels = Vec::with_capacity(PassKernel::ALL.len());
+    for kernel in PassKernel::ALL {
+        let (file, extra) = kernel.source();
+        let all: Vec<_> = defines.iter().chain(extra).copied().collect();
+        let mut k = Kernel::new(ctx, file, &all, &layout, 4)?;
+        if kernel == PassKernel::TemporalUnmoved {
+            k.set_variant("(unmoved camera)");
+        }
+        kernels.push(k);
+    }
+    Ok(kernels)
 }

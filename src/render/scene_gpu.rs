@@ -15,7 +15,7 @@ use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
 use crate::scene::Scene;
 use crate::shader_interface::SceneBinding;
-use crate::shading::bsdf::lobe_weights;
+use crate::shading::bsdf::{has_specular_layer, lobe_weights};
 use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context};
 
 pub struct SceneGpu {
@@ -165,6 +165,7 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("BSDF_DIFFUSE", flag(used(|w| w.0))),
         ("BSDF_CONDUCTOR", flag(used(|w| w.1))),
         ("BSDF_DIELECTRIC", flag(used(|w| w.2))),
+        ("BSDF_SPECULAR", flag(scene.materials.iter().any(has_specular_layer))),
         ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
         ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),

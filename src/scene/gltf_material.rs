@@ -1,4 +1,5 @@
-//! glTF materials to [`Material`]: metallic-roughness factors, emission, transmission, and the
+//! glTF materials to [`Material`]: metallic-roughness factors, emission, transmission,
+//! `KHR_materials_specular`, and the
 //! approximations for `KHR_materials_unlit`, `KHR_materials_pbrSpecularGlossiness` and COLOR_0.
 
 use anyhow::{bail, Result};
@@ -80,6 +81,11 @@ impl Loader<'_> {
             ("occlusion", m.occlusion_texture().is_some()),
             ("emissive", m.emissive_texture().is_some()),
             ("transmission", m.transmission().is_some_and(|t| t.transmission_texture().is_some())),
+            ("specular", m.specular().is_some_and(|s| s.specular_texture().is_some())),
+            (
+                "specular colour",
+                m.specular().is_some_and(|s| s.specular_color_texture().is_some()),
+            ),
             ("diffuse", sg.as_ref().is_some_and(|s| s.diffuse_texture().is_some())),
             (
                 "specular-glossiness",
@@ -117,6 +123,11 @@ impl Loader<'_> {
         let emissive = m.emissive_factor();
         let transmission = m.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0);
         let ior = m.ior().unwrap_or(1.5);
+        // KHR_materials_specular's defaults are the core spec's layer: strength 1, white F0 tint.
+        let (specular, specular_color) = m
+            .specular()
+            .map(|s| (s.specular_factor(), Vec3::from(s.specular_color_factor())))
+            .unwrap_or((1.0, Vec3::ONE));
         let checks = [
             (
                 "baseColorFactor",
@@ -127,6 +138,11 @@ impl Loader<'_> {
             ("emissiveFactor", emissive.iter().all(|v| v.is_finite() && *v >= 0.0)),
             ("emissiveStrength", strength.is_finite() && strength >= 0.0),
             ("transmissionFactor", (0.0..=1.0).contains(&transmission)),
+            ("specularFactor", (0.0..=1.0).contains(&specular)),
+            (
+                "specularColorFactor",
+                specular_color.is_finite() && specular_color.min_element() >= 0.0,
+            ),
             // Within rounding below 1 is index-matched (docs/materials.md), not an error.
             ("ior", ior.is_finite() && (ior >= 1.0 || crate::shading::bsdf::index_matched(ior))),
         ];
@@ -144,6 +160,8 @@ impl Loader<'_> {
                 transmission: 0.0,
                 ior: 1.5,
                 flags,
+                specular: 0.0,
+                specular_color: [0.0; 3],
                 pad: 0,
             });
         }
@@ -155,6 +173,8 @@ impl Loader<'_> {
             transmission,
             ior,
             flags,
+            specular,
+            specular_color: specular_color.into(),
             pad: 0,
         })
     }
@@ -167,6 +187,8 @@ impl Loader<'_> {
                 metallic: 1.0,
                 roughness: 1.0,
                 ior: 1.5,
+                specular: 1.0,
+                specular_color: [1.0; 3],
                 ..Default::default()
             });
             self.material_names.push("glTF default material".to_string());

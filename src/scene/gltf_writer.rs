@@ -13,9 +13,13 @@ pub struct MaterialSpec {
     pub transmission: f32,
     pub ior: f32,
     pub double_sided: bool,
+    /// `KHR_materials_specular` specularFactor of the non-metal part (glTF's default is 1);
+    /// written only where it differs from 1 on a material with a non-metal part.
+    pub specular: f32,
 }
 
 impl MaterialSpec {
+    /// A Lambertian surface: a non-metal without the specular layer (specularFactor 0).
     pub fn diffuse(c: Vec3) -> Self {
         Self {
             base_color: c,
@@ -25,6 +29,7 @@ impl MaterialSpec {
             transmission: 0.0,
             ior: 1.5,
             double_sided: false,
+            specular: 0.0,
         }
     }
     pub fn conductor(c: Vec3, roughness: f32) -> Self {
@@ -40,6 +45,15 @@ impl MaterialSpec {
             ior,
             roughness,
             ..Self::diffuse(Vec3::ONE)
+        }
+    }
+    /// A glTF non-metal as the core spec defines it: a Lambertian base under a GGX specular layer
+    /// of F0 0.04 (docs/materials.md).
+    pub fn plastic(c: Vec3, roughness: f32) -> Self {
+        Self {
+            roughness,
+            specular: 1.0,
+            ..Self::diffuse(c)
         }
     }
     pub fn emitter(radiance: Vec3) -> Self {
@@ -188,6 +202,10 @@ impl GltfBuilder {
             extensions.insert("KHR_materials_ior".into(), json!({ "ior": round6(m.ior) }));
             self.use_extension("KHR_materials_transmission");
             self.use_extension("KHR_materials_ior");
+        }
+        if m.specular != 1.0 && m.metallic < 1.0 && m.transmission < 1.0 {
+            extensions.insert("KHR_materials_specular".into(), json!({ "specularFactor": round6(m.specular) }));
+            self.use_extension("KHR_materials_specular");
         }
         if !extensions.is_empty() {
             value["extensions"] = Value::Object(extensions);

@@ -1,5 +1,6 @@
-//! The material model, twin of glsl/bsdf.glsl: a linear blend of a Lambertian lobe, a GGX
-//! conductor and a GGX (or smooth) dielectric. Directions point away from the surface.
+//! The material model, twin of glsl/bsdf.glsl: a linear blend of a Lambertian lobe under a GGX
+//! specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric
+//! (docs/materials.md). Directions point away from the surface.
 
 use glam::{Vec3, Vec4};
 use std::f32::consts::PI;
@@ -23,6 +24,7 @@ pub fn index_matched(eta: f32) -> bool {
 
 pub const LOBE_NONE: u32 = 0;
 pub const LOBE_DIFFUSE: u32 = 1;
+/// GGX reflection: the conductor and the non-metal specular layer.
 pub const LOBE_CONDUCTOR: u32 = 2;
 pub const LOBE_DIELECTRIC: u32 = 4;
 pub const LOBE_DELTA: u32 = 8;
@@ -113,10 +115,31 @@ pub fn refract_dir(w: Vec3, m: Vec3, eta: f32) -> Option<(Vec3, f32)> {
     Some((-w / eta + (cos_i / eta - cos_t) * m, eta))
 }
 
+/// The split by metallic and transmission factors: (non-metal (diffuse base and its specular
+/// layer), conductor, dielectric), summing to 1.
 pub fn lobe_weights(m: &Material) -> (f32, f32, f32) {
     let t = m.transmission.clamp(0.0, 1.0);
     let k = m.metallic.clamp(0.0, 1.0);
     ((1.0 - t) * (1.0 - k), (1.0 - t) * k, t)
+}
+
+/// Whether the material's non-metal part has a specular layer (`specular_layer_fresnel` is not
+/// identically zero).
+pub fn has_specular_layer(m: &Material) -> bool {
+    lobe_weights(m).0 > 0.0 && m.specular > 0.0
+}
+
+/// The non-metal's specular-layer Fresnel `weight * fr` (RGB) at |cos_o| from the shading normal:
+/// `KHR_materials_specular`'s `fresnel_mix` with `f0 = min(((ior - 1) / (ior + 1))² specularColor, 1)`
+/// and Schlick's approximation, taken at the shading normal instead of at wo·h so that the layer
+/// never gains energy (docs/materials.md). Twin of GLSL `specular_layer_fresnel`.
+pub fn specular_layer_fresnel(m: &Material, cos_o: f32) -> Vec3 {
+    if !(m.specular > 0.0) {
+        return Vec3::ZERO;
+    }
+    let r = (m.ior - 1.0) / (m.ior + 1.0);
+    let f0 = (r * r * Vec3::from(m.specular_color)).min(Vec3::ONE);
+    m.specular * fresnel_schlick(f0, cos_o.abs())
 }
 
 /// Rough dielectric (f * |cos_i|, pdf) in the local frame; +z is the outside.
@@ -173,15 +196,18 @@ pub fn bsdf_eval_pdf_local(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     let flip = Vec3::new(1.0, 1.0, side);
     let (wo_s, wi_s) = (wo * flip, wi * flip);
     let same_side = wo_s.z > 0.0 && wi_s.z > 0.0;
-    if w_d > 0.0 && same_side {
-        f_cos += w_d * base * INV_PI * wi_s.z;
-        pdf += w_d * pdf_cosine_hemisphere(wi_s.z);
+    // The layer's tint and its share of the non-metal's selection probability.
+    let layer = w_d * specular_layer_fresnel(m, wo_s.z);
+    let p_layer = layer.max_element();
+    if w_d > p_layer && same_side {
+        f_cos += (w_d - p_layer) * base * INV_PI * wi_s.z;
+        pdf += (w_d - p_layer) * pdf_cosine_hemisphere(wi_s.z);
     }
-    if w_c > 0.0 && same_side && alpha >= DELTA_ALPHA {
+    if w_c + p_layer > 0.0 && same_side && alpha >= DELTA_ALPHA {
         let h = (wo_s + wi_s).normalize();
-        let f = fresnel_schlick(base, wo_s.dot(h));
-        f_cos += w_c * f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
-        pdf += w_c * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
+        let f = w_c * fresnel_schlick(base, wo_s.dot(h)) + layer;
+        f_cos += f * ggx_d(h, alpha) * smith_g2(wo_s, wi_s, alpha) / (4.0 * wo_s.z);
+        pdf += (w_c + p_layer) * smith_g1(wo_s, alpha) * ggx_d(h, alpha) / (4.0 * wo_s.z);
     }
     if w_t > 0.0 && alpha >= DELTA_ALPHA && !index_matched(m.ior) {
         let (fc, p) = dielectric_eval_pdf(wo, wi, alpha, m.ior);
@@ -191,14 +217,53 @@ pub fn bsdf_eval_pdf_local(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
     (f_cos, pdf)
 }
 
-/// (f * |cos_i| of the non-delta lobes, solid-angle pdf of `bsdf_sample` producing wi).
-pub fn bsdf_eval_pdf(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+/// pbrt-v4's orientation (`SurfaceInteraction::SetShadingGeometry`): the shading normal `ns`
+/// turned into the geometric normal `ng`'s hemisphere. Twin of GLSL `shading_normal_facing`.
+pub fn shading_normal_facing(ng: Vec3, ns: Vec3) -> Vec3 {
+    if ns.dot(ng) < 0.0 {
+        -ns
+    } else {
+        ns
+    }
+}
+
+/// Mitsuba's strict normals: whether direction `w` lies on the same (strict) side of the
+/// geometric normal `ng` and the shading normal `ns`; a direction where they disagree carries
+/// nothing. Twin of GLSL `sides_agree`.
+pub fn sides_agree(ng: Vec3, ns: Vec3, w: Vec3) -> bool {
+    let (a, b) = (w.dot(ng), w.dot(ns));
+    (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
+}
+
+/// (f * |cos_i| of the non-delta lobes, solid-angle pdf of `bsdf_sample` producing wi), with the
+/// cosine against the shading normal; `ng` geometric, `ns` shading normal (unit, world space).
+/// Zero where wo or wi lies on different sides of the two normals ([`sides_agree`]).
+pub fn bsdf_eval_pdf(m: &Material, ng: Vec3, ns: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+    let n = shading_normal_facing(ng, ns);
+    if !sides_agree(ng, n, wo) || !sides_agree(ng, n, wi) {
+        return (Vec3::ZERO, 0.0);
+    }
     let (t, b) = build_onb(n);
     bsdf_eval_pdf_local(m, to_local(wo, t, b, n), to_local(wi, t, b, n))
 }
 
-/// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice.
-pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
+/// u.xy: direction, u.z: lobe choice, u.w: reflection/transmission choice; `ng` geometric, `ns`
+/// shading normal (unit, world space). A sample on different sides of the two normals fails.
+pub fn bsdf_sample(m: &Material, ng: Vec3, ns: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
+    let n = shading_normal_facing(ng, ns);
+    if !sides_agree(ng, n, wo_world) {
+        return BsdfSample::FAILED;
+    }
+    let s = bsdf_sample_frame(m, n, wo_world, u);
+    if s.lobe == LOBE_NONE || !sides_agree(ng, n, s.wi) {
+        return BsdfSample::FAILED;
+    }
+    s
+}
+
+/// [`bsdf_sample`] in the frame of normal `n` alone (no side checks). Twin of GLSL
+/// `bsdf_sample_frame`.
+pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
     let (t, b) = build_onb(n);
     let wo = to_local(wo_world, t, b, n);
     if wo.z == 0.0 {
@@ -210,15 +275,19 @@ pub fn bsdf_sample(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample
     let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
     let flip = Vec3::new(1.0, 1.0, side);
     let wo_s = wo * flip;
+    let layer = w_d * specular_layer_fresnel(m, wo_s.z);
+    let p_layer = layer.max_element();
     let mirrored = Vec3::new(-wo.x, -wo.y, wo.z);
-    let (wi, lobe) = if u.z < w_d {
+    // Lobe choice: diffuse w_d - p_layer, GGX reflection w_c + p_layer, dielectric w_t.
+    let (wi, lobe) = if u.z < w_d - p_layer {
         (sample_cosine_hemisphere(u.truncate().truncate()) * flip, LOBE_DIFFUSE)
     } else if u.z < w_d + w_c {
         if alpha < DELTA_ALPHA {
+            let pdf = w_c + p_layer;
             return BsdfSample {
                 wi: to_world(mirrored, t, b, n),
-                weight: fresnel_schlick(base, wo_s.z),
-                pdf: w_c,
+                weight: (w_c * fresnel_schlick(base, wo_s.z) + layer) / pdf,
+                pdf,
                 lobe: LOBE_CONDUCTOR | LOBE_DELTA,
             };
         }

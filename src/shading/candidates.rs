@@ -120,7 +120,7 @@ pub fn stream_path_candidates(
         let m = material_of(scene, &x);
         let u = rng_uniform4(seed, i as u32, STREAM_RESAMPLE);
         if let Some((ls, light)) = nee_vertex(scene, &x, seed, i) {
-            let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&m, x.normal, wo, ls.dir);
+            let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&m, x.normal, x.normal, wo, ls.dir);
             if f_cos.max_element() > 0.0 && visible(scene, &x, &light) {
                 let weight = f_cos / ls.pdf;
                 // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand.

@@ -27,7 +27,9 @@ use crate::gpu_types::{Material, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
 use crate::scene::PunctualKind;
 use crate::scene::Scene;
-use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, index_matched, lobe_weights, BsdfSample, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE};
+use crate::shading::bsdf::{
+    bsdf_eval_pdf, bsdf_sample, has_specular_layer, index_matched, lobe_weights, BsdfSample, DELTA_ALPHA, LOBE_DELTA, LOBE_NONE,
+};
 use crate::shading::lights::{
     emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
     punctual_pdf, sample_light, LightSample,
@@ -184,13 +186,15 @@ fn shift_ok(record: PathRecord, jacobian: f32, vertices: Vec<Vertex>) -> ShiftRe
 }
 
 /// Whether a vertex may be a reconnection endpoint: every lobe of its material is rough
-/// (diffuse, or GGX at least as rough as the threshold). Escaped directions count as rough.
+/// (diffuse, or GGX, including a non-metal's specular layer, at least as rough as the threshold).
+/// Escaped directions count as rough.
 pub fn vertex_is_rough(scene: &Scene, v: &Vertex, params: &ShiftParams) -> bool {
     if vertex_is_escaped(v) || vertex_is_punctual(v) {
         return true;
     }
     let m = &scene.materials[scene.triangles[v.triangle as usize].material as usize];
     let (_, w_c, w_t) = lobe_weights(m);
+    let w_c = if has_specular_layer(m) { 1.0 } else { w_c };
     let rough_ggx = m.roughness >= params.roughness_threshold && m.roughness * m.roughness >= DELTA_ALPHA;
     // An index-matched dielectric is a pass-through, a delta lobe at any roughness.
     (w_c <= 0.0 || rough_ggx) && (w_t <= 0.0 || (rough_ggx && !index_matched(m.ior)))
@@ -286,7 +290,7 @@ pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee
         return if nee_end { 0.0 } else { 1.0 };
     }
     let (dir, _) = direction(scene, x, end);
-    let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, (before - x.pos).normalize(), dir);
+    let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, x.normal, (before - x.pos).normalize(), dir);
     let light = light_pdf(scene, x, end);
     if nee_end {
         balance_heuristic(light, bsdf_pdf)
@@ -353,7 +357,7 @@ fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: us
             if !visible(scene, &x, &end) {
                 return None;
             }
-            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, wo, ls.dir).0 / ls.pdf)
+            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, x.normal, wo, ls.dir).0 / ls.pdf)
         } else {
             let (s, next) = bsdf_vertex(scene, &x, wo, &m, seed, i)?;
             (next, s.lobe, s.weight)
@@ -387,7 +391,7 @@ pub(crate) fn nee_vertex(scene: &Scene, x: &Vertex, seed: u32, i: usize) -> Opti
 /// numbers, and the vertex its ray reaches (its hit, or the environment); `None` if no lobe was
 /// sampled.
 pub(crate) fn bsdf_vertex(scene: &Scene, x: &Vertex, wo: Vec3, m: &Material, seed: u32, i: usize) -> Option<(BsdfSample, Vertex)> {
-    let s = bsdf_sample(m, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
+    let s = bsdf_sample(m, x.normal, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
     if s.lobe == LOBE_NONE {
         return None;
     }
@@ -539,7 +543,13 @@ struct Link {
 
 fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, nee_at_r: bool) -> Link {
     let (dir, dist) = direction(scene, prev, x_r);
-    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, prev), prev.normal, (before - prev.pos).normalize(), dir);
+    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(
+        &material_of(scene, prev),
+        prev.normal,
+        prev.normal,
+        (before - prev.pos).normalize(),
+        dir,
+    );
     let pdf = if nee_at_r { light_pdf(scene, prev, x_r) } else { bsdf_pdf };
     // A punctual x_r is one fixed point or direction whatever joins it: no area factor.
     let geometry = if vertex_is_escaped(x_r) || vertex_is_punctual(x_r) {
@@ -554,7 +564,7 @@ fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, n
 /// from x_r (the light's when NEE chose it).
 fn pdf_after(scene: &Scene, x_r: &Vertex, dir_in: Vec3, next: &Vertex, next_is_nee: bool) -> (Vec3, f32) {
     let (dir_next, _) = direction(scene, x_r, next);
-    let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, -dir_in, dir_next);
+    let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, x_r.normal, -dir_in, dir_next);
     (f_cos, if next_is_nee { light_pdf(scene, x_r, next) } else { pdf })
 }
 

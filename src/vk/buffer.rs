@@ -28,6 +28,30 @@ pub enum BufferUsage {
     Addressed,
 }
 
+impl BufferUsage {
+    /// The Vulkan usage flags and the memory the allocator places the buffer in.
+    fn flags_and_location(self) -> (vk::BufferUsageFlags, MemoryLocation) {
+        match self {
+            BufferUsage::Storage => (
+                vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::UNIFORM_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            ),
+            BufferUsage::Params => (vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu),
+            BufferUsage::Staging => (
+                vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            ),
+            BufferUsage::Addressed => (
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            ),
+        }
+    }
+}
+
 pub struct Buffer {
     pub handle: vk::Buffer,
     pub size: u64,
@@ -49,24 +73,7 @@ impl Buffer {
                 limit: ctx.info.max_allocation_bytes,
             });
         }
-        let (flags, location) = match usage {
-            BufferUsage::Storage => (
-                vk::BufferUsageFlags::STORAGE_BUFFER
-                    | vk::BufferUsageFlags::UNIFORM_BUFFER
-                    | vk::BufferUsageFlags::TRANSFER_SRC
-                    | vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuOnly,
-            ),
-            BufferUsage::Params => (vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::CpuToGpu),
-            BufferUsage::Staging => (
-                vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            ),
-            BufferUsage::Addressed => (
-                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS | vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuOnly,
-            ),
-        };
+        let (flags, location) = usage.flags_and_location();
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(flags)
@@ -170,6 +177,28 @@ impl Buffer {
             self.ctx.device.cmd_copy_buffer(cmd, self.handle, staging.handle, &region);
         })?;
         staging.read(count)
+    }
+
+    /// Reads `count` elements from `offset` bytes into a host-visible buffer (a readback
+    /// buffer after the copies into it completed).
+    pub fn read_mapped<T: bytemuck::Pod>(&self, offset: u64, count: usize) -> Result<Vec<T>, GpuError> {
+        let bytes = (count * std::mem::size_of::<T>()) as u64;
+        assert!(
+            offset + bytes <= self.size,
+            "read of {bytes} bytes at {offset} from a {}-byte buffer",
+            self.size
+        );
+        let mapped = self.mapped().ok_or(GpuError::Vulkan {
+            during: "mapping a readback buffer",
+            result: vk::Result::ERROR_MEMORY_MAP_FAILED,
+        })?;
+        Ok(bytemuck::pod_collect_to_vec(&mapped[offset as usize..(offset + bytes) as usize]))
+    }
+
+    /// Records a copy of this buffer's first `bytes` into `dst` at `dst_offset`.
+    pub fn record_copy_to(&self, cmd: vk::CommandBuffer, dst: &Buffer, dst_offset: u64, bytes: u64) {
+        let region = [vk::BufferCopy::default().dst_offset(dst_offset).size(bytes)];
+        unsafe { self.ctx.device.cmd_copy_buffer(cmd, self.handle, dst.handle, &region) };
     }
 
     /// Records a fill of the whole buffer with one 32-bit pattern (e.g. NaN bits or zero).

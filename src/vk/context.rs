@@ -124,7 +124,6 @@ impl Context {
     pub fn new(options: &ContextOptions) -> Result<Self> {
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| anyhow!("cannot load the Vulkan loader (libvulkan.so.1): {e}; run tools/setup.sh"))?;
-
         let validation = options.validation && {
             let layers = unsafe { entry.enumerate_instance_layer_properties() }.unwrap_or_default();
             let found = layers.iter().any(|l| l.layer_name_as_c_str().ok() == Some(VALIDATION_LAYER));
@@ -133,78 +132,14 @@ impl Context {
             }
             true
         };
-
-        let app_name = CString::new("restir-pt").expect("static name has no NUL");
-        let app_info = vk::ApplicationInfo::default()
-            .application_name(&app_name)
-            .engine_name(&app_name)
-            .api_version(vk::API_VERSION_1_2);
-        let layer_ptrs = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-        let ext_ptrs = if validation {
-            vec![ash::ext::debug_utils::NAME.as_ptr()]
-        } else {
-            vec![]
-        };
-
         let validation_log = Arc::<ValidationLog>::default();
-        let log_ptr = &*validation_log as *const ValidationLog as *mut c_void;
-        let messenger_info = || {
-            vk::DebugUtilsMessengerCreateInfoEXT::default()
-                .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
-                .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
-                .pfn_user_callback(Some(debug_callback))
-                .user_data(log_ptr)
-        };
-        let mut instance_messenger = messenger_info();
-        let mut instance_info = vk::InstanceCreateInfo::default()
-            .application_info(&app_info)
-            .enabled_layer_names(&layer_ptrs)
-            .enabled_extension_names(&ext_ptrs);
-        if validation {
-            // Chained so that messages from instance creation itself are caught too.
-            instance_info = instance_info.push_next(&mut instance_messenger);
-        }
-        let instance = unsafe { entry.create_instance(&instance_info, None) }
-            .map_err(|e| anyhow!("cannot create a Vulkan instance: {e:?} (is a Vulkan driver such as mesa-vulkan-drivers installed?)"))?;
-
         // From here on a failure must destroy the instance; the guard does that until ownership moves.
-        let mut guard = InstanceGuard {
-            instance: Some(instance),
-            debug: None,
-        };
-        if validation {
-            let loader = ash::ext::debug_utils::Instance::new(&entry, guard.instance());
-            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info(), None) }
-                .map_err(vk_error("creating the debug messenger"))?;
-            guard.debug = Some((loader, messenger));
-        }
+        let guard = create_instance(&entry, validation, &validation_log)?;
         let (physical_device, queue_family, mut info) = pick_device(guard.instance(), options.device.as_deref())?;
         info.scene_binding_limit = options
             .scene_binding_limit
             .map_or(info.max_storage_buffer_range, |l| l.min(info.max_storage_buffer_range));
-
-        let priorities = [1.0f32];
-        let queue_infos = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(queue_family)
-            .queue_priorities(&priorities)];
-        let mut address_features = vk::PhysicalDeviceBufferDeviceAddressFeatures::default().buffer_device_address(true);
-        let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
-        if info.buffer_device_address {
-            device_info = device_info.push_next(&mut address_features);
-        }
-        let device = unsafe { guard.instance().create_device(physical_device, &device_info, None) }
-            .map_err(vk_error("creating the logical device"))?;
-        let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let command_pool = match unsafe { device.create_command_pool(&pool_info, None) } {
-            Ok(pool) => pool,
-            Err(e) => {
-                unsafe { device.destroy_device(None) };
-                return Err(vk_error("creating the command pool")(e).into());
-            }
-        };
+        let (device, queue, command_pool) = create_device(guard.instance(), physical_device, queue_family, info.buffer_device_address)?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: guard.instance().clone(),
             device: device.clone(),
@@ -376,6 +311,83 @@ impl Drop for InstanceGuard {
                 }
                 instance.destroy_instance(None);
             }
+        }
+    }
+}
+
+/// The instance, with the validation layer and a messenger that reports into `log` when
+/// `validation` is set; owned by the returned guard.
+fn create_instance(entry: &ash::Entry, validation: bool, log: &Arc<ValidationLog>) -> Result<InstanceGuard> {
+    let app_name = CString::new("restir-pt").expect("static name has no NUL");
+    let app_info = vk::ApplicationInfo::default()
+        .application_name(&app_name)
+        .engine_name(&app_name)
+        .api_version(vk::API_VERSION_1_2);
+    let layer_ptrs = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
+    let ext_ptrs = if validation {
+        vec![ash::ext::debug_utils::NAME.as_ptr()]
+    } else {
+        vec![]
+    };
+    let log_ptr = &**log as *const ValidationLog as *mut c_void;
+    let messenger_info = || {
+        vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
+            .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(log_ptr)
+    };
+    let mut instance_messenger = messenger_info();
+    let mut instance_info = vk::InstanceCreateInfo::default()
+        .application_info(&app_info)
+        .enabled_layer_names(&layer_ptrs)
+        .enabled_extension_names(&ext_ptrs);
+    if validation {
+        // Chained so that messages from instance creation itself are caught too.
+        instance_info = instance_info.push_next(&mut instance_messenger);
+    }
+    let instance = unsafe { entry.create_instance(&instance_info, None) }
+        .map_err(|e| anyhow!("cannot create a Vulkan instance: {e:?} (is a Vulkan driver such as mesa-vulkan-drivers installed?)"))?;
+    let mut guard = InstanceGuard {
+        instance: Some(instance),
+        debug: None,
+    };
+    if validation {
+        let loader = ash::ext::debug_utils::Instance::new(entry, guard.instance());
+        let messenger =
+            unsafe { loader.create_debug_utils_messenger(&messenger_info(), None) }.map_err(vk_error("creating the debug messenger"))?;
+        guard.debug = Some((loader, messenger));
+    }
+    Ok(guard)
+}
+
+/// The logical device with one queue of `queue_family` (and buffer device addresses when
+/// `device_address`), that queue and a command pool on it.
+fn create_device(
+    instance: &ash::Instance,
+    physical_device: vk::PhysicalDevice,
+    queue_family: u32,
+    device_address: bool,
+) -> Result<(ash::Device, vk::Queue, vk::CommandPool)> {
+    let priorities = [1.0f32];
+    let queue_infos = [vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(queue_family)
+        .queue_priorities(&priorities)];
+    let mut address_features = vk::PhysicalDeviceBufferDeviceAddressFeatures::default().buffer_device_address(true);
+    let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
+    if device_address {
+        device_info = device_info.push_next(&mut address_features);
+    }
+    let device = unsafe { instance.create_device(physical_device, &device_info, None) }.map_err(vk_error("creating the logical device"))?;
+    let queue = unsafe { device.get_device_queue(queue_family, 0) };
+    let pool_info = vk::CommandPoolCreateInfo::default()
+        .queue_family_index(queue_family)
+        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+    match unsafe { device.create_command_pool(&pool_info, None) } {
+        Ok(pool) => Ok((device, queue, pool)),
+        Err(e) => {
+            unsafe { device.destroy_device(None) };
+            Err(vk_error("creating the command pool")(e).into())
         }
     }
 }

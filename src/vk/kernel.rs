@@ -297,6 +297,24 @@ pub fn record_compute_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
     };
 }
 
+/// Makes transfer writes visible to the host once the submission's fence has signalled.
+pub fn record_host_read_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::HOST_READ)];
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::HOST,
+            vk::DependencyFlags::empty(),
+            &barrier,
+            &[],
+            &[],
+        )
+    };
+}
+
 impl Drop for Kernel {
     fn drop(&mut self) {
         let device = &self.ctx.device;

@@ -9,7 +9,7 @@ mod timer;
 
 pub use buffer::{Buffer, BufferUsage};
 pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
-pub use kernel::{record_compute_barrier, Binding, BindingSlot, BoundBuffer, Kernel, KernelCompile};
+pub use kernel::{record_compute_barrier, record_host_read_barrier, Binding, BindingSlot, BoundBuffer, Kernel, KernelCompile};
 pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};
 pub use shader::{compile_kernel, glsl_source};
 pub use timer::PassTimer;

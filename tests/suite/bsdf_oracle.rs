@@ -26,24 +26,58 @@ pub fn random_material(r: &mut TestRng) -> Material {
         3 => (r.uniform(), 0.0),
         _ => (r.uniform(), r.uniform()),
     };
+    // The non-metal's specular layer: absent (Lambertian), the core spec's, or a
+    // KHR_materials_specular strength and tint (a tint up to 25 reaches F0 = 1 in a channel).
+    let (specular, specular_color) = match (r.uniform() * 3.0) as u32 {
+        0 => (0.0, [0.0; 3]),
+        1 => (1.0, [1.0; 3]),
+        _ => (r.uniform(), [25.0 * r.uniform(), 25.0 * r.uniform(), 25.0 * r.uniform()]),
+    };
     Material {
         base_color: [0.05 + 0.95 * r.uniform(), 0.05 + 0.95 * r.uniform(), 0.05 + 0.95 * r.uniform()],
         metallic,
         roughness,
         transmission,
         ior: 1.0 + 1.5 * r.uniform(),
+        specular,
+        specular_color,
         ..Default::default()
     }
 }
 
-fn near_decision(m: &Material, n: Vec3, wo: Vec3, u: Vec4) -> bool {
+/// A shading normal for geometric normal `n`: `n` itself for half the items, else tilted by up
+/// to about 37°, and for one item in eight also flipped (to be turned back by
+/// `shading_normal_facing`).
+pub fn random_shading_normal(r: &mut TestRng, n: Vec3) -> Vec3 {
+    let k = r.uniform();
+    let tilted = (n + 0.6 * r.unit_vector()).normalize();
+    if k < 0.5 {
+        n
+    } else if k < 0.875 {
+        tilted
+    } else {
+        -tilted
+    }
+}
+
+/// Whether direction `w` is within rounding of either normal's plane, where GLSL and Rust may
+/// disagree on `sides_agree`.
+fn near_side(ng: Vec3, ns: Vec3, w: Vec3) -> bool {
+    w.dot(ng).abs() < 1e-4 || w.dot(ns).abs() < 1e-4
+}
+
+fn near_decision(m: &Material, ng: Vec3, ns: Vec3, wo: Vec3, u: Vec4) -> bool {
+    let n = shading_normal_facing(ng, ns);
     let (w_d, w_c, _) = lobe_weights(m);
     let cos_o = n.dot(wo);
     let fr_smooth = fresnel_dielectric(cos_o, m.ior);
+    let p_layer = w_d * specular_layer_fresnel(m, cos_o).max_element();
     (u.z - w_d).abs() < DECISION_MARGIN
+        || (u.z - (w_d - p_layer)).abs() < DECISION_MARGIN
         || (u.z - (w_d + w_c)).abs() < DECISION_MARGIN
         || (u.w - fr_smooth).abs() < DECISION_MARGIN
         || cos_o.abs() < 1e-3
+        || near_side(ng, n, wo)
 }
 
 #[test]
@@ -52,11 +86,13 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
     let mut r = TestRng(99);
     let n_items = 1 << 14;
     let mut materials = Vec::with_capacity(n_items);
-    let mut inputs = Vec::with_capacity(4 * n_items);
+    let mut inputs = Vec::with_capacity(5 * n_items);
     for _ in 0..n_items {
         materials.push(random_material(&mut r));
+        let ng = r.unit_vector();
         inputs.extend([
-            r.unit_vector().extend(0.0),
+            ng.extend(0.0),
+            random_shading_normal(&mut r, ng).extend(0.0),
             r.unit_vector().extend(0.0),
             r.unit_vector().extend(0.0),
         ]);
@@ -77,24 +113,29 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
     let mut sampled = 0;
     for i in 0..n_items {
         let m = &materials[i];
-        let (n, wo, wi, u) = (
-            inputs[4 * i].truncate(),
-            inputs[4 * i + 1].truncate(),
-            inputs[4 * i + 2].truncate(),
-            inputs[4 * i + 3],
+        let (ng, ns, wo, wi, u) = (
+            inputs[5 * i].truncate(),
+            inputs[5 * i + 1].truncate(),
+            inputs[5 * i + 2].truncate(),
+            inputs[5 * i + 3].truncate(),
+            inputs[5 * i + 4],
         );
-        let (f, pdf) = bsdf_eval_pdf(m, n, wo, wi);
+        if near_side(ng, ns, wi) || near_decision(m, ng, ns, wo, u) {
+            excluded += 1;
+            continue;
+        }
+        let (f, pdf) = bsdf_eval_pdf(m, ng, ns, wo, wi);
         assert_vec3_close(format_args!("bsdf_eval_pdf f item {i} for {m:?}"), out[3 * i].truncate(), f, TOL);
         assert!(
             close(out[3 * i].w, pdf, TOL),
             "bsdf_eval_pdf pdf item {i}: GLSL {} vs Rust {pdf}",
             out[3 * i].w
         );
-        if near_decision(m, n, wo, u) {
+        let s = bsdf_sample(m, ng, ns, wo, u);
+        if s.lobe != LOBE_NONE && near_side(ng, ns, s.wi) {
             excluded += 1;
             continue;
         }
-        let s = bsdf_sample(m, n, wo, u);
         let lobe = out[3 * i + 2].w.to_bits();
         assert_eq!(lobe, s.lobe, "bsdf_sample lobe item {i} for {m:?}");
         if s.lobe != LOBE_NONE {
@@ -135,7 +176,8 @@ fn bsdf_sample_pdf_and_weight_are_consistent_with_bsdf_eval_pdf() {
     for _ in 0..50_000 {
         let m = random_material(&mut r);
         let (n, wo) = (r.unit_vector(), r.unit_vector());
-        let s = bsdf_sample(&m, n, wo, Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
+        let ns = random_shading_normal(&mut r, n);
+        let s = bsdf_sample(&m, n, ns, wo, Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
         assert!(s.weight.is_finite() && s.pdf.is_finite(), "non-finite sample for {m:?}");
         if s.lobe == LOBE_NONE || s.lobe & LOBE_DELTA != 0 {
             continue;
@@ -149,7 +191,7 @@ fn bsdf_sample_pdf_and_weight_are_consistent_with_bsdf_eval_pdf() {
             continue;
         }
         let tol = 1e-3 * (1.0 + s.pdf / 1e3);
-        let (f, pdf) = bsdf_eval_pdf(&m, n, wo, s.wi);
+        let (f, pdf) = bsdf_eval_pdf(&m, n, ns, wo, s.wi);
         assert!(close(s.pdf, pdf, tol), "sampled pdf {} vs evaluated {pdf} for {m:?}", s.pdf);
         assert!(
             (s.weight - f / pdf).abs().max_element() <= tol * (1.0 + s.weight.max_element()),
@@ -199,17 +241,26 @@ fn bsdf_pdf_integrates_to_sampling_success_rate() {
         },
     ];
     let n = Vec3::Z;
+    // With a tilted shading normal, directions on different sides of the two normals carry
+    // nothing: the rejected samples and the zero pdf there must match.
+    let tilted = Vec3::new(0.45, 0.0, 0.9).normalize();
     for m in &materials {
-        for wo in [Vec3::new(0.3, 0.1, 0.9).normalize(), Vec3::new(0.8, 0.0, -0.3).normalize()] {
+        for (ns, wo) in [
+            (n, Vec3::new(0.3, 0.1, 0.9).normalize()),
+            (n, Vec3::new(0.8, 0.0, -0.3).normalize()),
+            (tilted, Vec3::new(0.3, 0.1, 0.9).normalize()),
+            (tilted, Vec3::new(-0.3, 0.2, 0.6).normalize()),
+            (tilted, Vec3::new(0.8, 0.0, -0.3).normalize()),
+        ] {
             let trials = 200_000;
             let successes = (0..trials)
-                .filter(|_| bsdf_sample(m, n, wo, Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform())).lobe != LOBE_NONE)
+                .filter(|_| bsdf_sample(m, n, ns, wo, Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform())).lobe != LOBE_NONE)
                 .count() as f64
                 / trials as f64;
             let samples: Vec<f64> = (0..trials)
                 .map(|_| {
                     let wi = r.unit_vector();
-                    bsdf_eval_pdf(m, n, wo, wi).1 as f64 * 4.0 * std::f64::consts::PI
+                    bsdf_eval_pdf(m, n, ns, wo, wi).1 as f64 * 4.0 * std::f64::consts::PI
                 })
                 .collect();
             let mean = samples.iter().sum::<f64>() / trials as f64;
@@ -217,7 +268,7 @@ fn bsdf_pdf_integrates_to_sampling_success_rate() {
             let se = (var / trials as f64 + successes * (1.0 - successes) / trials as f64).sqrt();
             assert!(
                 (mean - successes).abs() < 4.0 * se + 1e-3,
-                "{m:?}, wo {wo}: integral {mean:.4} vs success rate {successes:.4} (se {se:.4})"
+                "{m:?}, ns {ns}, wo {wo}: integral {mean:.4} vs success rate {successes:.4} (se {se:.4})"
             );
         }
     }

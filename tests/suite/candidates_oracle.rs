@@ -99,7 +99,10 @@ fn stream_path_candidates_glsl_matches_rust() {
             &ctx,
             "oracle/candidates_oracle.comp",
             &scene_gpu.buffers(&frame),
-            &[bytemuck::cast_slice(&kernel_params), bytemuck::cast_slice(&inputs)],
+            &[
+                ("Params", bytemuck::cast_slice(&kernel_params)),
+                ("Items", bytemuck::cast_slice(&inputs)),
+            ],
             ITEMS * 8 * 4,
             ITEMS as u32,
         );

@@ -117,7 +117,7 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
     for case in &cases {
         for _ in 0..SAMPLES {
             materials.push(glass(case.ior, case.roughness));
-            inputs.extend([Vec4::Z, case.wo.extend(0.0), Vec4::Z]);
+            inputs.extend([Vec4::Z, Vec4::Z, case.wo.extend(0.0), Vec4::Z]);
             inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
         }
     }
@@ -140,7 +140,7 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
         for k in c * SAMPLES..(c + 1) * SAMPLES {
             let weight = out[3 * k + 2];
             gpu_e.push(energy(weight.truncate(), weight.w.to_bits(), case.ior, case.wo.z));
-            let s = bsdf_sample(&materials[k], Vec3::Z, case.wo, inputs[4 * k + 3]);
+            let s = bsdf_sample(&materials[k], Vec3::Z, Vec3::Z, case.wo, inputs[5 * k + 4]);
             cpu_e.push(energy(s.weight, s.lobe, case.ior, case.wo.z));
         }
         let gpu_mean = check(&format!("GLSL, {what}"), case, &gpu_e);

@@ -75,7 +75,7 @@ type StructLayout = (&'static str, usize, Vec<(String, u32)>);
 
 fn scene_structs() -> Vec<StructLayout> {
     vec![
-        rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, pad),
+        rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, specular, specular_color, pad),
         rust_fields!(Triangle: v0, material, e1, emitter, e2, pad),
         rust_fields!(BvhNode: lo, skip, hi, leaf),
         rust_fields!(Emitter: triangle, select_pdf, alias_prob, alias),

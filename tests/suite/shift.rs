@@ -349,7 +349,7 @@ struct Causes {
 #[test]
 fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
     use restir_pt::scene::bvh::trace_occluded;
-    use restir_pt::shading::bsdf::{bsdf_eval_pdf, lobe_weights};
+    use restir_pt::shading::bsdf::{bsdf_eval_pdf, has_specular_layer, lobe_weights};
     use restir_pt::shading::ray_offset::offset_ray_origin;
     let mut total = Causes::default();
     let mut diverged = 0;
@@ -363,7 +363,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
             let is_delta = |v: &Vertex| {
                 let m = material(v);
                 let (_, w_c, w_t) = lobe_weights(&m);
-                (w_c > 0.0 || w_t > 0.0) && m.roughness * m.roughness < restir_pt::shading::bsdf::DELTA_ALPHA
+                (w_c > 0.0 || w_t > 0.0 || has_specular_layer(&m)) && m.roughness * m.roughness < restir_pt::shading::bsdf::DELTA_ALPHA
             };
             let check = |result: &ShiftResult, what: &str| {
                 assert!(
@@ -380,7 +380,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
                 let origin = offset_ray_origin(y1.pos, facing(y1.normal, dir), &scene.triangles[y1.triangle as usize]);
                 let target = offset_ray_origin(x2.pos, facing(x2.normal, -dir), &scene.triangles[x2.triangle as usize]);
                 let wo = (camera - y1.pos).normalize();
-                let (f, _) = bsdf_eval_pdf(&material(&y1), y1.normal, wo, dir);
+                let (f, _) = bsdf_eval_pdf(&material(&y1), y1.normal, y1.normal, wo, dir);
                 if is_delta(&y1) || is_delta(&x1) || is_delta(&x2) {
                     check(&rec, "a reconnection at a delta vertex");
                     total.delta += 1;
