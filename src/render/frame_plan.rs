@@ -238,7 +238,7 @@ mod tests {
                 assert_eq!(plan.final_slot, kept);
                 assert_eq!(plan.passes.len(), reuse + 1 + rounds as usize);
                 for pass in &plan.passes[..reuse] {
-                    assert!(history.map_or(true, |h| pass.slots.out_slot != h));
+                    assert!(history != Some(pass.slots.out_slot));
                 }
                 for pass in &plan.passes[reuse..] {
                     assert!(pass.slots.out_slot != kept || pass.kernel == PassKernel::Shade && rounds == 0);
