@@ -238,7 +238,7 @@ mod tests {
                 assert_eq!(plan.final_slot, kept);
                 assert_eq!(plan.passes.len(), reuse + 1 + rounds as usize);
                 for pass in &plan.passes[..reuse] {
-                    assert!(history != Some(pass.slots.out_slot));
+                    assert!(history.is_none_or(|h| pass.slots.out_slot != h));
                 }
                 for pass in &plan.passes[reuse..] {
                     assert!(pass.slots.out_slot != kept || pass.kernel == PassKernel::Shade && rounds == 0);
