@@ -9,24 +9,7 @@ use restir_pt::render::{PassKernel, PathTracer, RenderSettings, Restir, RestirSe
 use restir_pt::scene::{load_scene, Scene};
 
 use crate::common::{assert_clean, gpu, repo_path};
-
-const SIDE: u32 = 64;
-const FRAMES: usize = 3;
-
-fn settings(spp: u32) -> RenderSettings {
-    RenderSettings {
-        width: SIDE,
-        height: SIDE,
-        spp,
-        max_depth: 5,
-        camera: FRAMES - 1,
-        ..Default::default()
-    }
-}
-
-fn luminance(v: glam::Vec3) -> f64 {
-    (0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z) as f64
-}
+use crate::restir_unbiased::{luminance, settings, FRAMES};
 
 #[test]
 fn restir_same_seed_is_bit_identical() {

@@ -18,13 +18,16 @@ use crate::common::{assert_clean, gpu, repo_path};
 
 use crate::statistics::{max_failing_blocks, student_t_two_sided, ALPHA};
 
+/// The side of the unbiasedness tests' images, in pixels.
 const SIDE: u32 = 64;
 const BLOCK: u32 = 8;
 const RENDERS: u32 = 32;
 const REFERENCE_SPP: u32 = 4096;
-const FRAMES: usize = 3;
+/// Frames per chain: initial candidates, then temporal and spatial reuse along cameras 0..FRAMES.
+pub const FRAMES: usize = 3;
 
-fn settings(spp: u32) -> RenderSettings {
+/// SIDE x SIDE from camera FRAMES - 1, max depth 5, `spp` samples per pixel.
+pub fn settings(spp: u32) -> RenderSettings {
     RenderSettings {
         width: SIDE,
         height: SIDE,
@@ -35,7 +38,8 @@ fn settings(spp: u32) -> RenderSettings {
     }
 }
 
-fn luminance(v: glam::Vec3) -> f64 {
+/// Rec. 709 luminance.
+pub fn luminance(v: glam::Vec3) -> f64 {
     (0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z) as f64
 }
 
