@@ -198,7 +198,13 @@ impl Loader<'_> {
                 .filter(|_| base.is_some() || !matches!(image.source(), gltf::image::Source::Uri { .. })),
             self.buffers,
         )
-        .map_err(|e| problem(path, format!("image {}: cannot decode: {e}", image.index())))?;
+        .map_err(|e| {
+            let what = match image.source() {
+                gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => format!("image {} ({uri})", image.index()),
+                _ => format!("image {}", image.index()),
+            };
+            problem(path, format!("{what}: cannot read or decode: {e}"))
+        })?;
         let mut rgba =
             to_rgba8(&data).ok_or_else(|| problem(path, format!("image {}: unsupported pixel format {:?}", image.index(), data.format)))?;
         while rgba.width() > MAX_TEXTURE_SIDE || rgba.height() > MAX_TEXTURE_SIDE {

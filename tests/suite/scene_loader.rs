@@ -157,7 +157,10 @@ fn loader_warns_about_textures_and_rejects_unsupported_required_extensions() {
         v["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
     });
     let e = load_error(&path);
-    assert!(e.contains("missing-image.gltf") && e.contains("image 0: cannot decode"), "{e}");
+    assert!(
+        e.contains("missing-image.gltf") && e.contains("image 0 (missing.png): cannot read or decode"),
+        "{e}"
+    );
     let path = scene_file("required.gltf", floor(), Some(lamp()), |v| {
         v["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
         v["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
