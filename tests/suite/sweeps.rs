@@ -4,20 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::cli::restir_pt;
 use crate::common::temp_file;
-
-fn restir_pt(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_restir-pt"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn ok(args: &[&str]) -> (String, String) {
     let (code, stdout, stderr) = restir_pt(args);
