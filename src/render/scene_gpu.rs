@@ -223,6 +223,10 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_SURFACE", flag(!scene.surfaces.is_empty())),
         ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
     ];
+    // Only scenes that alpha-test define it: opaque scenes keep their kernels' code unchanged.
+    if scene.alpha().is_some() {
+        defines.push(("SCENE_ALPHA", "1".to_string()));
+    }
     if uniform {
         defines.extend([
             ("SCENE_TRIANGLE_COUNT", scene.triangles.len().max(1).to_string()),
