@@ -3,6 +3,7 @@
 
 mod common;
 
+mod alpha_oracle;
 mod bench_cli;
 mod bsdf_oracle;
 mod bvh_oracle;
