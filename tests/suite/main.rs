@@ -3,6 +3,7 @@
 
 mod common;
 
+mod alpha_images;
 mod alpha_oracle;
 mod bench_cli;
 mod bsdf_oracle;
