@@ -13,6 +13,7 @@ mod cli;
 mod cli_behaviour;
 mod cli_measurement;
 mod dielectric_furnace;
+mod double_sided;
 mod furnace;
 mod gris;
 mod gris_oracle;
