@@ -24,7 +24,12 @@ const HALF_TAN: f32 = 0.5;
 
 /// A 2 x 2 PNG, black, with the alphas of [`MASK_ALPHAS`] (row-major from the top row).
 pub fn mask_png() -> Vec<u8> {
-    let img = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba([0, 0, 0, (MASK_ALPHAS[(y * 2 + x) as usize] * 255.0).round() as u8]));
+    png_with_alphas(MASK_ALPHAS)
+}
+
+/// A 2 x 2 white PNG with `alphas` (row-major from the top row, rounded to 8 bits).
+pub fn png_with_alphas(alphas: [f32; 4]) -> Vec<u8> {
+    let img = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba([255, 255, 255, (alphas[(y * 2 + x) as usize] * 255.0).round() as u8]));
     let mut out = std::io::Cursor::new(Vec::new());
     image::DynamicImage::ImageRgba8(img)
         .write_to(&mut out, image::ImageFormat::Png)

@@ -168,21 +168,26 @@ const EVERY_CONFIGURATION: &[(ShiftKind, ReuseMis)] = &[
 ];
 
 fn check_unbiased(test: Unbiasedness) {
+    let scene = load_scene(&repo_path(&format!("scenes/{}.gltf", test.scene))).unwrap();
+    check_unbiased_on(test, &scene);
+}
+
+/// `check_unbiased` on a scene built by the test (`test.scene` names it).
+fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
     let name = if test.static_camera {
         format!("{} (static camera)", test.scene)
     } else {
         test.scene.to_string()
     };
     let ctx = gpu();
-    let scene = load_scene(&repo_path(&format!("scenes/{}.gltf", test.scene))).unwrap();
-    let reference = blocks(&reference(&ctx, &scene));
+    let reference = blocks(&reference(&ctx, scene));
     let mut max_failing = max_failing_blocks(reference.len());
     if test.path_tracer_control {
         let mut control = RenderSet::new(reference.len());
         for seed in 0..test.renders {
             let mut pt = PathTracer::new(
                 &ctx,
-                &scene,
+                scene,
                 &RenderSettings {
                     seed: 5000 + seed,
                     ..settings(test.candidates)
@@ -210,11 +215,11 @@ fn check_unbiased(test: Unbiasedness) {
             reservoirs: test.reservoirs,
             ..test.base.clone()
         };
-        let mut renderer = Restir::new(&ctx, &scene, &settings(1), &restir).unwrap();
+        let mut renderer = Restir::new(&ctx, scene, &settings(1), &restir).unwrap();
         let mut set = RenderSet::new(reference.len());
         let mut failed_rate = 0.0;
         for seed in 0..test.renders {
-            let (image, failed) = render_chain(&mut renderer, &scene, 1000 + seed, test.static_camera);
+            let (image, failed) = render_chain(&mut renderer, scene, 1000 + seed, test.static_camera);
             failed_rate += failed / test.renders as f64;
             set.add(&image, &reference);
         }
@@ -337,4 +342,31 @@ fn restir_unbiased_veach_door() {
         configurations: EVERY_CONFIGURATION,
         base: RestirSettings::default(),
     });
+}
+
+// A Cornell box whose light shines through a screen cut out by an alpha mask (half its texels
+// below the cutoff): every shift's vertices and visibility tests must see the same holes.
+#[test]
+fn restir_unbiased_alpha_masked_cornell() {
+    let checker = crate::alpha_images::png_with_alphas([0.8, 0.4, 0.4, 0.8]);
+    let text = restir_pt::scene::bundled_scenes::cornell_alpha_screen(&checker);
+    let scene = restir_pt::scene::load_scene_from_bytes(text.as_bytes(), None, std::path::Path::new("cornell-alpha.gltf")).unwrap();
+    assert!(scene.alpha().is_some(), "the screen must be alpha-tested");
+    check_unbiased_on(
+        Unbiasedness {
+            scene: "cornell with a masked screen",
+            renders: RENDERS,
+            candidates: 1,
+            reservoirs: 1,
+            path_tracer_control: false,
+            static_camera: false,
+            configurations: &[
+                (ShiftKind::Reconnection, ReuseMis::GeneralizedBalance),
+                (ShiftKind::Replay, ReuseMis::Pairwise),
+                (ShiftKind::Hybrid, ReuseMis::GeneralizedBalance),
+            ],
+            base: RestirSettings::default(),
+        },
+        &scene,
+    );
 }
