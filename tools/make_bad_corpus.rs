@@ -154,16 +154,16 @@ fn decode_base64(s: &str) -> Vec<u8> {
 /// A corpus file: its name in tests/data/bad/ and its bytes.
 type Case = (&'static str, Vec<u8>);
 
+/// glTF JSON cut off inside the scene list.
+const CUT_OFF_JSON: &[u8] = b"{ \"asset\": { \"version\": \"2.0\" }, \"scenes\": [ { \"nodes\": [0";
+
 /// Files that are not a readable glTF at all (and the valid binary one they are cut from).
 fn unreadable_files() -> anyhow::Result<Vec<Case>> {
     let valid = glb(base(floor(), lamp()));
     Ok(vec![
         ("truncated.glb", valid[..valid.len() / 2].to_vec()),
         ("valid.glb", valid.clone()),
-        (
-            "bad-json.gltf",
-            b"{ \"asset\": { \"version\": \"2.0\" }, \"scenes\": [ { \"nodes\": [0".to_vec(),
-        ),
+        ("bad-json.gltf", CUT_OFF_JSON.to_vec()),
         ("not-gltf.gltf", b"this is not a glTF file\n".to_vec()),
         ("empty-file.gltf", Vec::new()),
         ("missing-bin.gltf", edited(|v| v["buffers"][0]["uri"] = json!("missing.bin"))),
