@@ -141,10 +141,18 @@ pub fn cornell_alpha_screen(mask_png: &[u8]) -> String {
     cornell_boxes(&mut b, white, white);
     let screen = b.material("masked screen", MaterialSpec::diffuse(WHITE));
     let texture = b.texture(mask_png, "image/png", [WRAP_REPEAT, WRAP_REPEAT], FILTER_NEAREST);
-    b.set_material_field(screen, &["pbrMetallicRoughness", "baseColorTexture"], serde_json::json!({ "index": texture }));
+    b.set_material_field(
+        screen,
+        &["pbrMetallicRoughness", "baseColorTexture"],
+        serde_json::json!({ "index": texture }),
+    );
     b.set_material_field(screen, &["alphaMode"], serde_json::json!("MASK"));
     let quad = MeshData::quad(Vec3::new(-0.7, 0.55, -0.7), Vec3::X * 1.4, Vec3::Z * 1.4);
-    let uv: Vec<glam::Vec2> = quad.positions.iter().map(|p| glam::Vec2::new(p.x + 0.7, p.z + 0.7) * (5.0 / 1.4)).collect();
+    let uv: Vec<glam::Vec2> = quad
+        .positions
+        .iter()
+        .map(|p| glam::Vec2::new(p.x + 0.7, p.z + 0.7) * (5.0 / 1.4))
+        .collect();
     let mesh = b.mesh_with_attributes("masked screen", &quad, None, &[&uv], screen);
     b.instance("masked screen", mesh, 0.0, Vec3::ZERO);
     cornell_camera_path(&mut b);

@@ -347,8 +347,7 @@ pub fn trace_pair(
                 };
             }
         }
-        *occluded |= enter_s
-            && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some_and(|(_, b)| keeps(i, b, &shadow));
+        *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some_and(|(_, b)| keeps(i, b, &shadow));
     };
     if brute_force {
         for i in 0..triangles.len() {

@@ -51,7 +51,10 @@ impl Loader<'_> {
     /// about; it is kept as written.
     pub(super) fn alpha_test(&mut self, m: &gltf::Material) -> (u32, f32) {
         use gltf::material::AlphaMode;
-        let name = m.name().map(str::to_string).unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
+        let name = m
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
         let cutoff = m.alpha_cutoff().unwrap_or(0.5);
         let mode = m.alpha_mode();
         if mode == AlphaMode::Opaque {
@@ -59,14 +62,20 @@ impl Loader<'_> {
         }
         let emits = m.unlit() || m.emissive_factor().iter().any(|&c| c > 0.0) && m.emissive_strength().unwrap_or(1.0) > 0.0;
         if emits {
-            self.warn(format!("{name}: alpha mode {mode:?} ignored on an emissive material (emitters are opaque)"));
+            self.warn(format!(
+                "{name}: alpha mode {mode:?} ignored on an emissive material (emitters are opaque)"
+            ));
             return (ALPHA_OPAQUE, cutoff);
         }
         if mode == AlphaMode::Blend {
             return (ALPHA_BLEND, cutoff);
         }
         if !(0.0..=1.0).contains(&cutoff) {
-            let effect = if cutoff > 1.0 { "no part of it is rendered" } else { "it is rendered opaque" };
+            let effect = if cutoff > 1.0 {
+                "no part of it is rendered"
+            } else {
+                "it is rendered opaque"
+            };
             self.warn(format!("{name}: alphaCutoff {cutoff} is outside [0, 1]; {effect}"));
         }
         (ALPHA_MASK, cutoff)

@@ -9,7 +9,8 @@ use anyhow::{bail, Result};
 
 use super::gltf_loader::{problem, Loader};
 use crate::shading::texture::{
-    texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
+    texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP,
+    TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
 };
 
 /// Textures larger than this on a side are halved until they fit (mipmaps are not built, so

@@ -11,6 +11,7 @@ use glam::{Vec2, Vec3};
 use restir_pt::render::{Image, PathTracer, RenderSettings};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData, FILTER_NEAREST, WRAP_REPEAT};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
+use restir_pt::shading::texture::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
 use serde_json::json;
 
 use crate::common::{assert_clean, gpu};
@@ -29,7 +30,9 @@ pub fn mask_png() -> Vec<u8> {
 
 /// A 2 x 2 white PNG with `alphas` (row-major from the top row, rounded to 8 bits).
 pub fn png_with_alphas(alphas: [f32; 4]) -> Vec<u8> {
-    let img = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba([255, 255, 255, (alphas[(y * 2 + x) as usize] * 255.0).round() as u8]));
+    let img = image::RgbaImage::from_fn(2, 2, |x, y| {
+        image::Rgba([255, 255, 255, (alphas[(y * 2 + x) as usize] * 255.0).round() as u8])
+    });
     let mut out = std::io::Cursor::new(Vec::new());
     image::DynamicImage::ImageRgba8(img)
         .write_to(&mut out, image::ImageFormat::Png)
@@ -61,7 +64,11 @@ fn add_screen(b: &mut GltfBuilder, screen: Screen, z: f32, half: f32) {
             (a, textured)
         }
     };
-    b.set_material_field(material, &["pbrMetallicRoughness", "baseColorFactor"], json!([0.0, 0.0, 0.0, alpha]));
+    b.set_material_field(
+        material,
+        &["pbrMetallicRoughness", "baseColorFactor"],
+        json!([0.0, 0.0, 0.0, alpha]),
+    );
     if textured {
         let texture = b.texture(&mask_png(), "image/png", [WRAP_REPEAT, WRAP_REPEAT], FILTER_NEAREST);
         b.set_material_field(material, &["pbrMetallicRoughness", "baseColorTexture"], json!({ "index": texture }));
@@ -94,7 +101,11 @@ pub fn screen_shadowing_a_wall(screen: Screen) -> Scene {
     let mut b = GltfBuilder::default();
     add_screen(&mut b, screen, 2.0, 0.5);
     let wall = b.material("wall", MaterialSpec::diffuse(Vec3::ONE));
-    let w = b.mesh("wall", &MeshData::quad(Vec3::new(-2.0, -2.0, 0.0), Vec3::X * 4.0, Vec3::Y * 4.0), wall);
+    let w = b.mesh(
+        "wall",
+        &MeshData::quad(Vec3::new(-2.0, -2.0, 0.0), Vec3::X * 4.0, Vec3::Y * 4.0),
+        wall,
+    );
     b.instance("wall", w, 0.0, Vec3::ZERO);
     b.punctual_light(
         json!({ "type": "directional", "intensity": std::f32::consts::PI }),
@@ -181,4 +192,56 @@ fn alpha_blend_lets_through_one_minus_alpha() {
             );
         }
     }
+}
+
+/// Odd alpha settings load with one warning line each, naming the file and the material: a
+/// cutoff above 1 (nothing rendered) or below 0 (opaque), and an alpha mode on an emitter (kept
+/// opaque). None of them stops the load, and no warning says "rendered opaque" for a MASK or
+/// BLEND material that is alpha-tested.
+#[test]
+fn alpha_odd_settings_are_warned_about() {
+    let mut b = GltfBuilder::default();
+    let specs = [("too high", "MASK", 1.5), ("negative", "MASK", -0.25), ("fine", "BLEND", 0.5)];
+    for (name, mode, cutoff) in specs {
+        let m = b.material(name, MaterialSpec::diffuse(Vec3::ONE));
+        b.set_material_field(m, &["alphaMode"], json!(mode));
+        b.set_material_field(m, &["alphaCutoff"], json!(cutoff));
+        let mesh = b.mesh(name, &MeshData::quad(Vec3::ZERO, Vec3::X, Vec3::Y), m);
+        b.instance(name, mesh, 0.0, Vec3::ZERO);
+    }
+    let lamp = b.material("lamp", MaterialSpec::emitter(Vec3::ONE));
+    b.set_material_field(lamp, &["alphaMode"], json!("BLEND"));
+    let mesh = b.mesh("lamp", &MeshData::quad(Vec3::Z, Vec3::X, Vec3::Y), lamp);
+    b.instance("lamp", mesh, 0.0, Vec3::ZERO);
+    let text = b.finish("odd alpha", Vec3::ONE);
+    let scene = load_scene_from_bytes(text.as_bytes(), None, std::path::Path::new("odd-alpha.gltf")).unwrap();
+    let warned = |what: &str| {
+        scene
+            .warnings
+            .iter()
+            .filter(|w| w.starts_with("odd-alpha.gltf: ") && w.contains(what))
+            .count()
+    };
+    assert_eq!(
+        warned("too high: alphaCutoff 1.5 is outside [0, 1]; no part of it is rendered"),
+        1,
+        "{:?}",
+        scene.warnings
+    );
+    assert_eq!(
+        warned("negative: alphaCutoff -0.25 is outside [0, 1]; it is rendered opaque"),
+        1,
+        "{:?}",
+        scene.warnings
+    );
+    assert_eq!(
+        warned("lamp: alpha mode Blend ignored on an emissive material"),
+        1,
+        "{:?}",
+        scene.warnings
+    );
+    assert_eq!(warned("fine"), 0, "{:?}", scene.warnings);
+    assert_eq!(warned("rendered opaque"), 0, "{:?}", scene.warnings);
+    let modes: Vec<u32> = scene.textures.materials.iter().map(|t| t.alpha_mode).collect();
+    assert_eq!(&modes[..4], &[ALPHA_MASK, ALPHA_MASK, ALPHA_BLEND, ALPHA_OPAQUE]);
 }

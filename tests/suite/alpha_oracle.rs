@@ -112,7 +112,9 @@ pub fn alpha_random_scene(seed: u64) -> Scene {
 fn decision_margin(scene: &Scene, alpha: &AlphaScene, o: Vec3, d: Vec3, tmax: f32) -> f32 {
     let mut margin = f32::INFINITY;
     for (i, tri) in scene.triangles.iter().enumerate() {
-        let Some((_, bary)) = intersect_triangle(o, d, tri, tmax) else { continue };
+        let Some((_, bary)) = intersect_triangle(o, d, tri, tmax) else {
+            continue;
+        };
         let t = &alpha.textures.materials[tri.material as usize];
         let a = material_alpha(t, alpha.textures, &scene.surface_at(i as u32, bary));
         margin = margin.min(match t.alpha_mode {
@@ -128,7 +130,10 @@ fn decision_margin(scene: &Scene, alpha: &AlphaScene, o: Vec3, d: Vec3, tmax: f3
 fn run_alpha_oracle(scene: &Scene, inputs: &[Vec4]) -> Vec<Vec4> {
     let ctx = gpu();
     let scene_gpu = SceneGpu::upload(&ctx, scene).unwrap();
-    assert!(scene_gpu.defines().contains(&("SCENE_ALPHA", "1")), "the scene must compile alpha testing in");
+    assert!(
+        scene_gpu.defines().contains(&("SCENE_ALPHA", "1")),
+        "the scene must compile alpha testing in"
+    );
     let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
     let params = Buffer::new(&ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
     params.write(&[FrameParams::default()]).unwrap();
@@ -186,7 +191,11 @@ fn alpha_traversal_glsl_matches_rust() {
         let t = &scene.textures.materials[scene.triangles[tri as usize].material as usize];
         let a = material_alpha(t, &scene.textures, &scene.surface_at(tri, bary));
         assert!(close(g[1].w, a, 1e-4), "material_alpha, item {i}: GLSL {} vs Rust {a}", g[1].w);
-        let threshold = if t.alpha_mode == ALPHA_MASK { t.alpha_cutoff } else { alpha_hash(o, d, tri) };
+        let threshold = if t.alpha_mode == ALPHA_MASK {
+            t.alpha_cutoff
+        } else {
+            alpha_hash(o, d, tri)
+        };
         if t.alpha_mode == ALPHA_OPAQUE || (a - threshold).abs() > MARGIN {
             let keeps = alpha_keeps(&alpha, &scene.triangles, tri, bary, o, d);
             assert_eq!(g[3].x == 1.0, keeps, "alpha_keeps, item {i}");
@@ -204,7 +213,10 @@ fn alpha_traversal_glsl_matches_rust() {
         assert_eq!(g[2].y.to_bits(), h.triangle, "trace_pair closest triangle, ray {i}");
         if h.triangle != NO_HIT {
             assert!(close(g[0].x, h.t, 1e-4) && close(g[2].x, h.t, 1e-4), "hit distance, ray {i}");
-            assert!((Vec2::new(g[0].z, g[0].w) - h.bary).abs().max_element() < 1e-4, "barycentrics, ray {i}");
+            assert!(
+                (Vec2::new(g[0].z, g[0].w) - h.bary).abs().max_element() < 1e-4,
+                "barycentrics, ray {i}"
+            );
         }
         let any = bvh_traverse(&scene.nodes, &scene.triangles, Some(&alpha), o, d, tmax_s, true).triangle != NO_HIT;
         assert_eq!(g[1].x == 1.0, any, "bvh_traverse any hit, ray {i}");
@@ -215,7 +227,11 @@ fn alpha_traversal_glsl_matches_rust() {
         };
         let closest = PairRay { tmax: 1e30, ..shadow };
         let (ph, occluded) = trace_pair(&scene.nodes, &scene.triangles, Some(&alpha), false, closest, shadow);
-        assert_eq!((ph.triangle, occluded), (h.triangle, any), "Rust trace_pair against bvh_traverse, ray {i}");
+        assert_eq!(
+            (ph.triangle, occluded),
+            (h.triangle, any),
+            "Rust trace_pair against bvh_traverse, ray {i}"
+        );
         assert_eq!(g[1].y == 1.0, occluded, "trace_pair occlusion, ray {i}");
     }
     println!("alpha oracle: {changed} of {RAYS} closest hits changed by alpha, {set_aside} set aside, alpha_keeps kept {kept} and dropped {dropped}");

@@ -14,7 +14,11 @@ use crate::alpha_images::{mean_and_error, render};
 fn square_under_the_sky(material: MaterialSpec) -> Scene {
     let mut b = GltfBuilder::default();
     let m = b.material("square", material);
-    let mesh = b.mesh("square", &MeshData::quad(Vec3::new(-2.0, -2.0, 0.0), Vec3::X * 4.0, Vec3::Y * 4.0), m);
+    let mesh = b.mesh(
+        "square",
+        &MeshData::quad(Vec3::new(-2.0, -2.0, 0.0), Vec3::X * 4.0, Vec3::Y * 4.0),
+        m,
+    );
     b.instance("square", mesh, 0.0, Vec3::ZERO);
     b.camera("front", Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 0.9);
     b.camera("back", Vec3::new(0.0, 0.0, -2.0), Vec3::ZERO, 0.9);
@@ -28,9 +32,23 @@ fn double_sided_decides_which_faces_emit_and_never_culls() {
     let white = MaterialSpec::diffuse(Vec3::splat(0.5));
     let cases = [
         ("single-sided emitter", lamp, [2.0, 0.0]),
-        ("double-sided emitter", MaterialSpec { double_sided: true, ..lamp }, [2.0, 2.0]),
+        (
+            "double-sided emitter",
+            MaterialSpec {
+                double_sided: true,
+                ..lamp
+            },
+            [2.0, 2.0],
+        ),
         ("single-sided white", white, [0.5, 0.5]),
-        ("double-sided white", MaterialSpec { double_sided: true, ..white }, [0.5, 0.5]),
+        (
+            "double-sided white",
+            MaterialSpec {
+                double_sided: true,
+                ..white
+            },
+            [0.5, 0.5],
+        ),
     ];
     for (what, material, expected) in cases {
         let mut scene = square_under_the_sky(material);
@@ -40,7 +58,10 @@ fn double_sided_decides_which_faces_emit_and_never_culls() {
                 scene.cameras.swap(0, 1);
             }
             let (mean, error) = mean_and_error(&render(&scene, 8, 3));
-            println!("{what}, seen from the {side}: {mean:.5} (standard error {error:.5}) vs {}", expected[camera]);
+            println!(
+                "{what}, seen from the {side}: {mean:.5} (standard error {error:.5}) vs {}",
+                expected[camera]
+            );
             assert!(
                 (mean - expected[camera]).abs() <= 0.01 * expected[camera].max(0.1),
                 "{what} seen from the {side}: {mean}, expected {}",
