@@ -160,7 +160,7 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(scene)]).unwrap();
+    params.write(&[settings.frame_params(scene_gpu.info())]).unwrap();
 
     let mut r = TestRng(2);
     let mut inputs = Vec::with_capacity(4 * RAYS);
@@ -313,7 +313,7 @@ fn environment_map_light_sampling_glsl_matches_rust() {
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(&scene)]).unwrap();
+    params.write(&[settings.frame_params(scene_gpu.info())]).unwrap();
     let mut r = TestRng(6);
     let mut inputs = Vec::with_capacity(4 * RAYS);
     for _ in 0..RAYS {

@@ -83,7 +83,7 @@ fn stream_path_candidates_glsl_matches_rust() {
             BufferUsage::Params,
         )
         .unwrap();
-        frame.write(&[RenderSettings::default().frame_params(&scene)]).unwrap();
+        frame.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
         let scale = 0.5f32;
         let kernel_params = [
             MAX_PATH_LENGTH as u32,
