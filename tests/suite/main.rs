@@ -28,6 +28,7 @@ mod scale;
 mod scale_invariance;
 mod scene_loader;
 mod scenes;
+mod shading_normal_scenes;
 mod shading_normals;
 mod shift;
 mod shift_oracle;

@@ -1,5 +1,6 @@
-//! GLSL surface.glsl and texture.glsl against src/surface.rs and src/texture.rs: surface_at,
-//! triangle_bary, texture_lookup, texture_coordinates, textured_material and normal_mapped on a
+//! GLSL surface.glsl, texture.glsl and shading_frame.glsl against src/surface.rs, src/texture.rs
+//! and src/scene/hit_surface.rs: surface_at, triangle_bary, texture_lookup, texture_coordinates,
+//! textured_material, normal_mapped, shading_normal and hit_shading (Scene methods) on a
 //! scene of random triangles with random vertex attributes and small random textures (every
 //! address mode, bilinear and nearest, sRGB and linear, KHR_texture_transform rows).
 
@@ -22,6 +23,8 @@ const TEXTURES: usize = 9;
 const MATERIALS: usize = 7;
 /// Relative agreement; sRGB decoding goes through llvmpipe's pow.
 const TOL: f32 = 2e-4;
+/// vec4 outputs per item (OUT_ROWS in surface_oracle.comp).
+const ROWS: usize = 10;
 
 fn random_textures(r: &mut TestRng) -> SceneTextures {
     let mut t = SceneTextures::default();
@@ -180,7 +183,7 @@ fn compare_surfaces(scene: &Scene) {
         inputs.push(p.extend(0.0));
     }
     let input = Buffer::from_slice(&ctx, "inputs", &inputs).unwrap();
-    let output = Buffer::new(&ctx, "outputs", (ITEMS * 8 * 16) as u64, BufferUsage::Storage).unwrap();
+    let output = Buffer::new(&ctx, "outputs", (ITEMS * ROWS * 16) as u64, BufferUsage::Storage).unwrap();
     output.fill(NAN_FILL).unwrap();
     // The oracle binds everything in set 0: the surface family at 5-8 (SURFACE_SET 0,
     // SURFACE_BINDING 5 in surface_oracle.comp), then the inputs and outputs.
@@ -202,14 +205,14 @@ fn compare_surfaces(scene: &Scene) {
     let kernel = Kernel::new(&ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
     kernel.bind(&buffers).unwrap();
     kernel.run_1d(ITEMS as u32, 64, bytemuck::bytes_of(&(ITEMS as u32))).unwrap();
-    let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(ITEMS * 32).unwrap()).to_vec();
+    let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(ITEMS * ROWS * 4).unwrap()).to_vec();
     let t = &scene.textures;
     let (mut skipped, mut compared) = (0, 0);
     for i in 0..ITEMS {
         let (a, b) = (inputs[3 * i], inputs[3 * i + 1]);
         let tri = a.x.to_bits();
         let bary = Vec2::new(a.y, a.z);
-        let g = &out[8 * i..8 * i + 8];
+        let g = &out[ROWS * i..ROWS * i + ROWS];
         let s = surface_at(&scene.triangles[tri as usize], &scene.surfaces[tri as usize], bary);
         assert_vec3_close(format!("surface_at normal, item {i}"), g[0].truncate(), s.normal, TOL);
         assert_eq!(g[0].w, s.handedness, "surface_at handedness, item {i}");
@@ -266,6 +269,18 @@ fn compare_surfaces(scene: &Scene) {
         );
         assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
         assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, &s), 1e-3);
+        let (hm, ns) = scene.hit_shading(tri, bary);
+        assert_vec3_close(
+            format!("shading_normal, item {i}"),
+            g[8].truncate(),
+            scene.shading_normal(tri, bary),
+            1e-3,
+        );
+        assert_vec3_close(format!("hit_shading normal, item {i}"), g[9].truncate(), ns, 1e-3);
+        assert!(
+            close(g[8].w, hm.roughness, TOL) && close(g[9].w, hm.metallic, TOL),
+            "hit_shading material, item {i}"
+        );
     }
     assert!(skipped < ITEMS / 20, "{skipped} of {ITEMS} items near a nearest-filter texel edge");
     assert!(compared > 0);
