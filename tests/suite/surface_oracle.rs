@@ -269,20 +269,27 @@ fn compare_surfaces(scene: &Scene) {
         );
         assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
         assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, &s), 1e-3);
-        let (hm, ns) = scene.hit_shading(tri, bary);
-        assert_vec3_close(
-            format!("shading_normal, item {i}"),
-            g[8].truncate(),
-            scene.shading_normal(tri, bary),
-            1e-3,
-        );
-        assert_vec3_close(format!("hit_shading normal, item {i}"), g[9].truncate(), ns, 1e-3);
-        assert!(
-            close(g[8].w, hm.roughness, TOL) && close(g[9].w, hm.metallic, TOL),
-            "hit_shading material, item {i}"
-        );
+        check_shading_frame(scene, &g[8..10], tri, bary, i);
     }
     assert!(skipped < ITEMS / 20, "{skipped} of {ITEMS} items near a nearest-filter texel edge");
     assert!(compared > 0);
     assert_clean(&ctx);
+}
+
+/// GLSL `shading_normal` (row 0's xyz) and `hit_shading` (row 1's xyz the normal, the material's
+/// roughness and metallic in the rows' w) of item `i` against `Scene::shading_normal` and
+/// `Scene::hit_shading`.
+fn check_shading_frame(scene: &Scene, rows: &[Vec4], tri: u32, bary: Vec2, i: usize) {
+    let (m, ns) = scene.hit_shading(tri, bary);
+    assert_vec3_close(
+        format!("shading_normal, item {i}"),
+        rows[0].truncate(),
+        scene.shading_normal(tri, bary),
+        1e-3,
+    );
+    assert_vec3_close(format!("hit_shading normal, item {i}"), rows[1].truncate(), ns, 1e-3);
+    assert!(
+        close(rows[0].w, m.roughness, TOL) && close(rows[1].w, m.metallic, TOL),
+        "hit_shading material, item {i}"
+    );
 }
