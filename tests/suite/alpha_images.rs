@@ -8,7 +8,7 @@
 use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
-use restir_pt::render::{Image, PathTracer, RenderSettings};
+use restir_pt::render::{Image, PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData, FILTER_NEAREST, WRAP_REPEAT};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
 use restir_pt::shading::texture::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
@@ -131,7 +131,7 @@ pub fn render(scene: &Scene, spp: u32, seed: u32) -> Image {
         russian_roulette: false,
         camera: 0,
     };
-    let mut tracer = PathTracer::new(&ctx, scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, scene).unwrap(), &settings).unwrap();
     tracer.render(&|_| {}, &AtomicBool::new(false)).unwrap();
     let image = tracer.image().unwrap();
     drop(tracer);
