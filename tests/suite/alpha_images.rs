@@ -197,7 +197,7 @@ fn alpha_blend_lets_through_one_minus_alpha() {
 /// Odd alpha settings load with one warning line each, naming the file and the material: a
 /// cutoff above 1 (nothing rendered) or below 0 (opaque), and an alpha mode on an emitter (kept
 /// opaque). None of them stops the load, and no warning says "rendered opaque" for a MASK or
-/// BLEND material that is alpha-tested.
+/// BLEND material that is alpha-tested (the old "alpha mode ... ignored (rendered opaque)").
 #[test]
 fn alpha_odd_settings_are_warned_about() {
     let mut b = GltfBuilder::default();
@@ -241,7 +241,7 @@ fn alpha_odd_settings_are_warned_about() {
         scene.warnings
     );
     assert_eq!(warned("fine"), 0, "{:?}", scene.warnings);
-    assert_eq!(warned("rendered opaque"), 0, "{:?}", scene.warnings);
+    assert_eq!(warned("ignored (rendered opaque)"), 0, "{:?}", scene.warnings);
     let modes: Vec<u32> = scene.textures.materials.iter().map(|t| t.alpha_mode).collect();
     assert_eq!(&modes[..4], &[ALPHA_MASK, ALPHA_MASK, ALPHA_BLEND, ALPHA_OPAQUE]);
 }
