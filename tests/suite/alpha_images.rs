@@ -196,8 +196,8 @@ fn alpha_blend_lets_through_one_minus_alpha() {
 
 /// Odd alpha settings load with one warning line each, naming the file and the material: a
 /// cutoff above 1 (nothing rendered) or below 0 (opaque), and an alpha mode on an emitter (kept
-/// opaque). None of them stops the load, and no warning says "rendered opaque" for a MASK or
-/// BLEND material that is alpha-tested (the old "alpha mode ... ignored (rendered opaque)").
+/// opaque). None of them stops the load, and no warning says that an alpha-tested MASK or BLEND
+/// material is "ignored (rendered opaque)".
 #[test]
 fn alpha_odd_settings_are_warned_about() {
     let mut b = GltfBuilder::default();
