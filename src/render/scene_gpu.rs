@@ -243,6 +243,7 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
         ("SCENE_SURFACE", flag(!scene.surfaces.is_empty())),
         ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
+        ("SCENE_SHADING_NORMALS", flag(scene.has_shading_normals())),
     ];
     if uniform {
         defines.extend([

@@ -31,6 +31,7 @@ mod scene_limits_and_env;
 mod scene_loader;
 mod scene_sharing;
 mod scenes;
+mod shading_normal_scenes;
 mod shading_normals;
 mod shared_assets;
 mod shift;
