@@ -29,6 +29,7 @@ mod scale;
 mod scale_invariance;
 mod scene_limits_and_env;
 mod scene_loader;
+mod scene_sharing;
 mod scenes;
 mod shading_normal_scenes;
 mod shading_normals;
