@@ -21,7 +21,7 @@ struct ShiftParams {
 // direction towards it.
 struct Vertex {
     vec3 pos;
-    vec3 normal;
+    vec3 normal;      // the geometric normal (as wound); vertex_shading gives the shading normal
     uint triangle;
 };
 
@@ -51,6 +51,24 @@ Vertex vertex_on_surface(uint triangle, vec3 pos) {
 Vertex vertex_escaped(vec3 dir) { return Vertex(dir, vec3(0.0), NO_HIT); }
 
 Material material_of(Vertex v) { return material_at(v.triangle, triangle_bary(triangles[v.triangle], v.pos)); }
+
+// The material at surface vertex v and its shading normal ns: the interpolated vertex normal with
+// the material's normal map applied (surface_at, normal_mapped), or v.normal where the scene has
+// no vertex attributes. BSDFs evaluate in the frame of ns, as the path tracer's do, so that
+// candidates, shifts and the path tracer share one target function; v.normal, the geometric
+// normal, keeps deciding sides, ray offsets and the measure (docs/shift-mappings.md, "Shading
+// frame").
+Material vertex_shading(Vertex v, out vec3 ns) {
+#if SCENE_SURFACE
+    uint material = triangles[v.triangle].material;
+    SurfaceHit s = surface_at(v.triangle, triangle_bary(triangles[v.triangle], v.pos));
+    ns = normal_mapped(material, s);
+    return textured_material(materials[material], material, s);
+#else
+    ns = v.normal;
+    return material_of(v);
+#endif
+}
 
 bool vertex_is_rough(Vertex v, ShiftParams params) {
     if (vertex_is_escaped(v) || vertex_is_punctual(v)) return true;
@@ -139,8 +157,10 @@ float end_mis_weight(Vertex x, vec3 before, Vertex end, bool nee_end, bool after
     vec3 dir;
     float dist;
     direction(x, end, dir, dist);
+    vec3 ns;
+    Material m = vertex_shading(x, ns);
     float bsdf_pdf;
-    bsdf_eval_pdf(material_of(x), x.normal, x.normal, normalize(before - x.pos), dir, bsdf_pdf);
+    bsdf_eval_pdf(m, x.normal, ns, normalize(before - x.pos), dir, bsdf_pdf);
     float light = light_pdf(x, end);
     return nee_end ? balance_heuristic(light, bsdf_pdf) : balance_heuristic(bsdf_pdf, light);
 }
