@@ -8,6 +8,7 @@
 #include "bvh.glsl"
 #include "lights.glsl"
 #include "punctual.glsl"
+#include "shading_frame.glsl"
 
 const float SHIFT_RAY_TMAX = 1e30;
 
@@ -52,22 +53,16 @@ Vertex vertex_escaped(vec3 dir) { return Vertex(dir, vec3(0.0), NO_HIT); }
 
 Material material_of(Vertex v) { return material_at(v.triangle, triangle_bary(triangles[v.triangle], v.pos)); }
 
-// The material at surface vertex v and its shading normal ns: the interpolated vertex normal with
-// the material's normal map applied (surface_at, normal_mapped), or v.normal where the scene has
-// no vertex attributes. BSDFs evaluate in the frame of ns, as the path tracer's do, so that
+// The material at surface vertex v and its shading normal ns: the path tracer's hit_shading
+// (the interpolated vertex normal with the material's normal map applied; v.normal in a scene
+// without shading normals). BSDFs evaluate in the frame of ns, as the path tracer's do, so that
 // candidates, shifts and the path tracer share one target function; v.normal, the geometric
 // normal, keeps deciding sides, ray offsets and the measure (docs/shift-mappings.md, "Shading
 // frame").
 Material vertex_shading(Vertex v, out vec3 ns) {
-#if SCENE_SURFACE
-    uint material = triangles[v.triangle].material;
-    SurfaceHit s = surface_at(v.triangle, triangle_bary(triangles[v.triangle], v.pos));
-    ns = normal_mapped(material, s);
-    return textured_material(materials[material], material, s);
-#else
-    ns = v.normal;
-    return material_of(v);
-#endif
+    Material m;
+    hit_shading(v.triangle, triangle_bary(triangles[v.triangle], v.pos), v.normal, m, ns);
+    return m;
 }
 
 bool vertex_is_rough(Vertex v, ShiftParams params) {

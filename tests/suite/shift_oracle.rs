@@ -78,7 +78,7 @@ fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, job
         BufferUsage::Params,
     )
     .unwrap();
-    frame.write(&[RenderSettings::default().frame_params(scene)]).unwrap();
+    frame.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
     let function = 3 * inverted as u32
         + match kind {
             Kind::Reconnection => 0,

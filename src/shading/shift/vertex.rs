@@ -123,17 +123,13 @@ pub(crate) fn material_of(scene: &Scene, v: &Vertex) -> Material {
 }
 
 /// The material at surface vertex `v` (textures applied) and its shading normal `ns` (unit, world
-/// space): the interpolated vertex normal with the material's normal map applied
-/// (`Scene::shading_normal`: `surface_at`, `normal_mapped`), or the geometric `v.normal` where the
-/// scene has no vertex attributes. BSDFs evaluate in the frame of `ns`, as the path tracer's do,
-/// so that candidates, shifts and the path tracer share one target function; `v.normal` keeps
-/// deciding sides, ray offsets and the measure (docs/shift-mappings.md, "Shading frame").
+/// space): the path tracer's `Scene::hit_shading` (the interpolated vertex normal with the
+/// material's normal map applied; the geometric normal in a scene without shading normals).
+/// BSDFs evaluate in the frame of `ns`, as the path tracer's do, so that candidates, shifts and
+/// the path tracer share one target function; `v.normal` keeps deciding sides, ray offsets and
+/// the measure (docs/shift-mappings.md, "Shading frame").
 pub fn vertex_shading(scene: &Scene, v: &Vertex) -> (Material, Vec3) {
-    if scene.surfaces.is_empty() {
-        return (material_of(scene, v), v.normal);
-    }
-    let bary = triangle_bary(&scene.triangles[v.triangle as usize], v.pos);
-    (scene.material_at(v.triangle, bary), scene.shading_normal(v.triangle, bary))
+    scene.hit_shading(v.triangle, triangle_bary(&scene.triangles[v.triangle as usize], v.pos))
 }
 
 /// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
