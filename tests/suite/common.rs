@@ -82,7 +82,7 @@ pub fn run_scene_oracle<T: bytemuck::Pod>(
 ) -> Vec<T> {
     let mut all = scene_gpu.defines();
     all.extend_from_slice(defines);
-    let build = |layout: &[BindingSlot]| scene_gpu.kernel(ctx, kernel, &all, layout.to_vec(), 4).unwrap();
+    let build = |layout: &[BindingSlot]| scene_gpu.kernel(kernel, &all, layout.to_vec(), 4).unwrap();
     run_built_oracle(ctx, build, &scene_gpu.buffers(frame), inputs, output_words, count)
 }
 
