@@ -15,6 +15,7 @@ mod furnace;
 mod gris;
 mod gris_oracle;
 mod layout;
+mod normal_mapped_scene;
 mod punctual;
 mod ray_offset;
 mod real_scenes;
