@@ -13,6 +13,7 @@ pub mod error;
 pub mod gpu_types;
 pub mod image_io;
 pub mod metrics;
+pub mod reference_shard;
 pub mod render;
 pub mod scene;
 pub mod shader_interface;

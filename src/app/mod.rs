@@ -29,7 +29,7 @@ pub use profile::{profile, ProfileArgs};
 pub use reference::{reference, variance_path, ReferenceArgs};
 pub use render::{render, MethodArg, RenderArgs};
 pub use render_output::{RenderReport, RestirFrameReport};
-pub use shard::{merge, merge_shards, read_shard, MergeArgs, ShardMeta, ShardSpec, ShardSums};
+pub use shard::{merge, MergeArgs};
 pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
 pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
 
