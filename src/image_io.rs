@@ -30,7 +30,9 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
 }
 
-pub(crate) fn srgb_encode(linear: f32) -> u8 {
+/// The 8-bit sRGB code of a linear value (IEC 61966-2-1 transfer function; clamped to [0, 1],
+/// rounded to nearest).
+pub fn srgb_encode(linear: f32) -> u8 {
     let c = linear.clamp(0.0, 1.0);
     let s = if c <= 0.0031308 {
         12.92 * c

@@ -4,11 +4,6 @@
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-/// The `restir-pt` command-line application: its commands, option groups, sweeps and charts.
-/// Not part of the embedding API (no stability promise); it lives in the library only so that
-/// the binary and the test suite share it.
-#[doc(hidden)]
-pub mod app;
 pub mod error;
 pub mod gpu_types;
 pub mod image_io;

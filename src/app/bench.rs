@@ -12,9 +12,9 @@ use clap::Args;
 
 use super::args::{DeviceArgs, SceneArgs, SizeArgs, Toggle};
 use super::{finish_device, load_with_options, open_device};
-use crate::metrics::median;
-use crate::render::{PathTracer, RenderSettings, TraversalCounters};
-use crate::scene::Scene;
+use restir_pt::metrics::median;
+use restir_pt::render::{PathTracer, RenderSettings, TraversalCounters};
+use restir_pt::scene::Scene;
 
 /// `restir-pt bench`.
 #[derive(Args, Debug, Clone)]

@@ -8,9 +8,9 @@ use glam::Vec3;
 
 use super::args::{DeviceArgs, RestirArgs, SceneArgs};
 use super::{finish_device, load_with_options, open_device};
-use crate::render::{PathTracer, RenderSettings, Restir};
-use crate::scene::Scene;
-use crate::vk::KernelCompile;
+use restir_pt::render::{PathTracer, RenderSettings, Restir};
+use restir_pt::scene::Scene;
+use restir_pt::vk::KernelCompile;
 
 /// Materials listed one per line; vertex colours can make thousands of variants.
 const MAX_LISTED_MATERIALS: usize = 64;
@@ -45,7 +45,7 @@ pub fn info(args: InfoArgs) -> Result<()> {
         let settings = RenderSettings {
             width: 8,
             height: 8,
-            max_depth: crate::shading::path_record::MAX_PATH_LENGTH as u32,
+            max_depth: restir_pt::shading::path_record::MAX_PATH_LENGTH as u32,
             ..Default::default()
         };
         let mut reports = vec![PathTracer::new(&ctx, &scene, &settings)?.compile_report().clone()];

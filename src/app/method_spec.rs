@@ -6,9 +6,9 @@ use std::sync::Arc;
 
 use anyhow::{bail, Result};
 
-use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
-use crate::scene::Scene;
-use crate::vk::Context;
+use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
+use restir_pt::scene::Scene;
+use restir_pt::vk::Context;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum MethodSpec {

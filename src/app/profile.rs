@@ -11,10 +11,10 @@ use clap::Args;
 use super::args::{DeviceArgs, PathArgs, RestirArgs, SceneArgs, SizeArgs};
 use super::render_output::{compile_progress, print_compile_summary};
 use super::{finish_device, load_with_options, open_device};
-use crate::metrics::quantile;
-use crate::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
-use crate::scene::{camera_on_path, Scene};
-use crate::vk::Context;
+use restir_pt::metrics::quantile;
+use restir_pt::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
+use restir_pt::scene::{camera_on_path, Scene};
+use restir_pt::vk::Context;
 
 /// `restir-pt profile`.
 #[derive(Args, Debug, Clone)]

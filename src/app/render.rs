@@ -14,10 +14,10 @@ use super::render_output::{
     RestirFrameReport,
 };
 use super::{finish_device, load_with_options, open_device};
-use crate::image_io::Exposure;
-use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings};
-use crate::scene::{camera_on_path, Scene};
-use crate::vk::Context;
+use restir_pt::image_io::Exposure;
+use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings};
+use restir_pt::scene::{camera_on_path, Scene};
+use restir_pt::vk::Context;
 
 /// The rendering method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -215,7 +215,7 @@ impl Job<'_> {
         frame: u32,
         report: &RenderReport,
         line: &str,
-        image: Option<&crate::render::Image>,
+        image: Option<&restir_pt::render::Image>,
         interrupted: bool,
     ) -> Result<bool> {
         println!("{}{line}", self.args.frame_prefix(frame, self.scene.cameras.len()));

@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 
 use super::reference::variance_path;
-use crate::image_io::write_exr;
-use crate::reference_shard::merge_shards;
-use crate::render::Image;
+use restir_pt::image_io::write_exr;
+use restir_pt::reference_shard::merge_shards;
+use restir_pt::render::Image;
 
 /// `restir-pt merge`: shards to the mean EXR at `out` and the variance EXR next to it.
 /// `restir-pt merge`.

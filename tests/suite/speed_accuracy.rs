@@ -1,8 +1,8 @@
-//! Speed against accuracy: the error metrics, `stability` on a small run (every pixel finite,
-//! energy within 2% of the references) and `compare`'s files.
+//! Speed against accuracy: the error metrics and `stability` on a small run (every pixel finite,
+//! energy within 2% of the references). The equal-time lines `compare` prints are checked by
+//! the unit test in src/app/compare_outputs.rs.
 
 use glam::Vec3;
-use restir_pt::app::{equal_time_lines, CompareRow};
 use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
 
 use crate::cli::restir_pt;
@@ -27,41 +27,6 @@ fn metrics_rel_mse_energy_and_flicker_match_hand_values() {
     assert!((rel_mse(&noisy, &black) - (999.0 * 0.01 + 100.0) / 1000.0).abs() < 1e-6);
     assert!((rel_mse_trimmed(&noisy, &black, 1e-3) - 0.01).abs() < 1e-6);
     assert!((rel_mse_trimmed(&noisy, &black, 0.0) - rel_mse(&noisy, &black)).abs() < 1e-9);
-}
-
-fn compare_row(method: &str, gpu_ms_per_frame: f64, rel_mse: f64) -> CompareRow {
-    CompareRow {
-        method: method.to_string(),
-        budget_ms: 100.0,
-        knob: String::new(),
-        gpu_ms_per_frame,
-        rel_mse,
-        rel_mse_trimmed: rel_mse / 2.0,
-        mse: rel_mse,
-        energy_ratio: 1.0,
-        failed_shift_rate: None,
-        nonfinite_pixels: 0,
-    }
-}
-
-/// The equal-time ratio takes the best ReSTIR PT run within 20% of the budget; a run that
-/// overshot it (here 190 ms for 100) is named and left out, however low its error.
-#[test]
-fn compare_equal_time_leaves_out_runs_over_budget() {
-    let rows = [
-        compare_row("pt", 95.0, 0.4),
-        compare_row("restir:reconnection/gbh", 110.0, 0.2),
-        compare_row("restir:hybrid/gbh", 190.0, 0.01),
-    ];
-    let lines = equal_time_lines(&rows, &[100.0]);
-    assert_eq!(
-        lines,
-        [
-            "equal time 100.0 ms: restir:hybrid/gbh left out, its frames took 190.0 ms",
-            "equal time 100.0 ms, relMSE: pt 4.0000e-1 (95.0 ms) / restir:reconnection/gbh 2.0000e-1 (110.0 ms) = 2.00x",
-            "equal time 100.0 ms, trimmed relMSE: pt 2.0000e-1 (95.0 ms) / restir:reconnection/gbh 1.0000e-1 (110.0 ms) = 2.00x",
-        ]
-    );
 }
 
 /// The path tracer and ReSTIR PT (hybrid) on cornell, 64x64, 16 frames with a static and a
