@@ -7,6 +7,11 @@ use glam::Vec3;
 
 use crate::render::Image;
 
+/// Writes `pixels` (`width * height`, row-major from the top left, linear RGB) as an RGB
+/// float EXR.
+///
+/// # Errors
+/// The file cannot be written; the message names `path`.
 pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<()> {
     let (w, h) = (width as usize, height as usize);
     exr::prelude::write_rgb_file(path, w, h, |x, y| {
@@ -16,6 +21,11 @@ pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Resul
     .map_err(|e| anyhow!("{}: cannot write EXR: {e}", path.display()))
 }
 
+/// Reads the first RGB(A) layer of an EXR: (width, height, row-major linear RGB pixels from the
+/// top left; alpha dropped).
+///
+/// # Errors
+/// The file cannot be read or holds no RGB layer; the message names `path`.
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
