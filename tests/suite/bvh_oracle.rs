@@ -155,16 +155,16 @@ fn oracle_settings() -> RenderSettings {
     }
 }
 
-/// The frame parameters of `scene` at `settings`, uploaded.
-fn params_buffer(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings) -> Buffer {
+/// The frame parameters of the uploaded `scene` at `settings`, on its device.
+fn params_buffer(scene: &SceneGpu, settings: &RenderSettings) -> Buffer {
     let params = Buffer::new(
-        ctx,
+        scene.ctx(),
         "params",
         std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(scene)]).unwrap();
+    params.write(&[settings.frame_params(scene.info())]).unwrap();
     params
 }
 
@@ -181,7 +181,7 @@ struct Coverage {
 fn check_scene_oracle(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, defines: &[(&str, &str)]) {
     // Punctual lights share the alias table: light sampling's delta branch is compared too.
     let settings = oracle_settings();
-    let params = params_buffer(ctx, scene, &settings);
+    let params = params_buffer(scene_gpu, &settings);
     let mut r = TestRng(2);
     let mut inputs = Vec::with_capacity(4 * RAYS);
     for i in 0..RAYS {
@@ -327,7 +327,7 @@ fn environment_map_light_sampling_glsl_matches_rust() {
     let scene = random_scene_full(5, vec![], Some(crate::sampling_statistics::test_environment_map()));
     assert!(scene.env_select_prob > 0.0 && scene.env_select_prob < 1.0);
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-    let params = params_buffer(&ctx, &scene, &oracle_settings());
+    let params = params_buffer(&scene_gpu, &oracle_settings());
     let mut r = TestRng(6);
     let mut inputs = Vec::with_capacity(4 * RAYS);
     for _ in 0..RAYS {

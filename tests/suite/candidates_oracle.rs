@@ -146,7 +146,7 @@ fn run_candidates_oracle(
         BufferUsage::Params,
     )
     .unwrap();
-    frame.write(&[RenderSettings::default().frame_params(scene)]).unwrap();
+    frame.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
     let kernel_params = [
         MAX_PATH_LENGTH as u32,
         params.roughness_threshold.to_bits(),

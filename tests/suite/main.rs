@@ -30,6 +30,7 @@ mod scale_invariance;
 mod scene_limits_and_env;
 mod scene_loader;
 mod scenes;
+mod shading_normal_scenes;
 mod shading_normals;
 mod shared_assets;
 mod shift;

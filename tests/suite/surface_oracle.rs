@@ -1,5 +1,6 @@
-//! GLSL surface.glsl and texture.glsl against src/surface.rs and src/texture.rs: surface_at,
-//! triangle_bary, texture_lookup, texture_coordinates, textured_material and normal_mapped on a
+//! GLSL surface.glsl, texture.glsl and shading_frame.glsl against src/surface.rs, src/texture.rs
+//! and src/scene/hit_surface.rs: surface_at, triangle_bary, texture_lookup, texture_coordinates,
+//! textured_material, normal_mapped, shading_normal and hit_shading (Scene methods) on a
 //! scene of random triangles with random vertex attributes and small random textures (every
 //! address mode, bilinear and nearest, sRGB and linear, KHR_texture_transform rows).
 
@@ -22,6 +23,8 @@ const TEXTURES: usize = 9;
 const MATERIALS: usize = 7;
 /// Relative agreement; sRGB decoding goes through llvmpipe's pow.
 const TOL: f32 = 2e-4;
+/// vec4 outputs per item (OUT_ROWS in surface_oracle.comp).
+const ROWS: usize = 10;
 
 fn random_textures(r: &mut TestRng) -> SceneTextures {
     let mut t = SceneTextures::default();
@@ -161,7 +164,7 @@ fn compare_surfaces(scene: &Scene) {
     let out = run_surface_oracle(&ctx, &scene_gpu, &inputs);
     let (mut skipped, mut compared) = (0, 0);
     for i in 0..ITEMS {
-        if check_item(scene, &inputs[3 * i..3 * i + 3], &out[8 * i..8 * i + 8], i) {
+        if check_item(scene, &inputs[3 * i..3 * i + 3], &out[ROWS * i..ROWS * i + ROWS], i) {
             compared += 1;
         } else {
             skipped += 1;
@@ -196,14 +199,14 @@ fn random_hits(scene: &Scene) -> Vec<Vec4> {
     inputs
 }
 
-/// Dispatches surface_oracle.comp over `inputs`; eight vec4s of results per item.
+/// Dispatches surface_oracle.comp over `inputs`; `ROWS` vec4s of results per item.
 fn run_surface_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene_gpu: &SceneGpu, inputs: &[Vec4]) -> Vec<Vec4> {
     let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
     assert_eq!(surface.buffers.len(), 4, "attributes and three texture buffers");
     let params = Buffer::new(ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
     params.write(&[FrameParams::default()]).unwrap();
     let input = Buffer::from_slice(ctx, "inputs", inputs).unwrap();
-    let output = Buffer::new(ctx, "outputs", (ITEMS * 8 * 16) as u64, BufferUsage::Storage).unwrap();
+    let output = Buffer::new(ctx, "outputs", (ITEMS * ROWS * 16) as u64, BufferUsage::Storage).unwrap();
     output.fill(NAN_FILL).unwrap();
     // The oracle binds everything in set 0: the surface family at 5-8 (SURFACE_SET 0,
     // SURFACE_BINDING 5 in surface_oracle.comp), then the inputs and outputs.
@@ -225,7 +228,7 @@ fn run_surface_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene_gpu: &
     let kernel = Kernel::new(ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
     kernel.bind(&buffers).unwrap();
     kernel.run_1d(ITEMS as u32, 64, bytemuck::bytes_of(&(ITEMS as u32))).unwrap();
-    bytemuck::cast_slice(&output.read::<u32>(ITEMS * 32).unwrap()).to_vec()
+    bytemuck::cast_slice(&output.read::<u32>(ITEMS * ROWS * 4).unwrap()).to_vec()
 }
 
 /// Asserts item `i`'s GLSL outputs `g` against the Rust twins; false when the item was skipped
@@ -274,6 +277,7 @@ fn check_item(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize) -> bool {
         "texture_coordinates, item {i}"
     );
     check_textured_material(scene, material, &s, g, i);
+    check_shading_frame(scene, &g[8..10], tri, bary, i);
     true
 }
 
@@ -296,4 +300,22 @@ fn check_textured_material(scene: &Scene, material: usize, s: &SurfaceHit, g: &[
     );
     assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
     assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, s), 1e-3);
+}
+
+/// GLSL `shading_normal` (row 0's xyz) and `hit_shading` (row 1's xyz the normal, the material's
+/// roughness and metallic in the rows' w) of item `i` against `Scene::shading_normal` and
+/// `Scene::hit_shading`.
+fn check_shading_frame(scene: &Scene, rows: &[Vec4], tri: u32, bary: Vec2, i: usize) {
+    let (m, ns) = scene.hit_shading(tri, bary);
+    assert_vec3_close(
+        format!("shading_normal, item {i}"),
+        rows[0].truncate(),
+        scene.shading_normal(tri, bary),
+        1e-3,
+    );
+    assert_vec3_close(format!("hit_shading normal, item {i}"), rows[1].truncate(), ns, 1e-3);
+    assert!(
+        close(rows[0].w, m.roughness, TOL) && close(rows[1].w, m.metallic, TOL),
+        "hit_shading material, item {i}"
+    );
 }
