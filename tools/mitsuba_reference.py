@@ -151,6 +151,17 @@ def make_lambertian(doc):
         used.append("KHR_materials_specular")
 
 
+def make_emissive(doc):
+    """Every material with a base colour texture emits it instead: emissiveTexture the same
+    textureInfo (coordinate set and transform included), emissiveFactor 1, base colour black."""
+    for m in doc.get("materials", []):
+        pbr = m.setdefault("pbrMetallicRoughness", {})
+        if "baseColorTexture" in pbr:
+            m["emissiveTexture"] = json.loads(json.dumps(pbr["baseColorTexture"]))
+            m["emissiveFactor"] = [1.0, 1.0, 1.0]
+            pbr["baseColorFactor"] = [0.0, 0.0, 0.0, 1.0]
+
+
 def add_sun(direction, irradiance, environment):
     """An edit that adds a KHR_lights_punctual directional light of `irradiance` (lux) shining
     along `direction` (a node whose -Z is rotated onto it) and sets the scene's constant
@@ -529,6 +540,8 @@ def main():
     ap.add_argument("--tiles", type=int, default=4)
     ap.add_argument("--lambertian", action="store_true",
                     help="render every material as a Lambertian of its base colour (make_lambertian)")
+    ap.add_argument("--emissive", action="store_true",
+                    help="every base colour texture becomes the material's emission (make_emissive)")
     ap.add_argument("--sun", metavar="DX,DY,DZ,E,ENV",
                     help="add a directional light along (DX, DY, DZ) of irradiance E and a constant environment ENV")
     ap.add_argument("--out", help="EXR of the image (all passes)")
@@ -541,7 +554,7 @@ def main():
         raise SystemExit("error: --spp %d is not a multiple of --passes %d" % (args.spp, args.passes))
     import mitsuba as mi
     mi.set_variant(args.variant)
-    edits = ([make_lambertian] if args.lambertian else []) + (
+    edits = ([make_lambertian] if args.lambertian else []) + ([make_emissive] if args.emissive else []) + (
         [add_sun((lambda v: (v[:3], v[3], v[4]))([float(x) for x in args.sun.split(",")])[0],
                  *[float(x) for x in args.sun.split(",")][3:5])] if args.sun else [])
     doc = Gltf(args.gltf, edits)
@@ -574,7 +587,7 @@ def main():
         "renderer": "mitsuba %s %s, path integrator" % (mi.__version__, args.variant),
         "settings": {"width": args.width, "height": args.height, "spp": args.spp, "passes": args.passes,
                      "max_depth": args.max_depth, "camera": args.camera, "tiles": args.tiles,
-                     "environment": env, "lambertian": args.lambertian, "sun": args.sun},
+                     "environment": env, "lambertian": args.lambertian, "emissive": args.emissive, "sun": args.sun},
         "command": "python3 tools/mitsuba_reference.py " + " ".join(sys.argv[1:]),
         "render_seconds": round(seconds, 1),
     }

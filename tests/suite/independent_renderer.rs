@@ -10,7 +10,8 @@
 //! (two-sided p = 6.8e-6 per comparison; over the 48 comparisons of a scene and the 5 scenes,
 //! a false failure has probability below 0.2% by Bonferroni), and δ the model difference:
 //! - 1% where both renderers evaluate the same BSDF (`make_lambertian`: every material a
-//!   Lambertian of its textured base colour, Mitsuba's `diffuse`); measured worst 0.4%;
+//!   Lambertian of its textured base colour, Mitsuba's `diffuse`; `make_emissive`: the base
+//!   colour texture as emission); measured worst 0.4% at 128 x 128 and 64 spp;
 //! - 15% on the files as published, whose non-metals Mitsuba renders with its `principled` BSDF
 //!   (Burley's diffuse, whose retro-reflection makes the albedo of a white rough base 1.048 at
 //!   normal view, against the glTF specification's 0.974 and restir-pt's 0.974;
@@ -32,6 +33,9 @@ const Z: f32 = 4.5;
 const SAME_MODEL: f32 = 0.01;
 /// Relative model difference between restir-pt's glTF non-metal and Mitsuba's `principled`.
 const PRINCIPLED: f32 = 0.15;
+/// Tile channels at least this bright count towards the printed worst relative difference (the
+/// dark ones are noise-dominated; the assertion covers every tile).
+const BRIGHT: f32 = 0.05;
 /// restir-pt's samples per pixel: its tile standard errors are then at most 0.8% of the mean
 /// (measured), against Mitsuba's 4096.
 const SPP: u32 = 256;
@@ -44,6 +48,7 @@ struct Reference {
     max_depth: u32,
     tiles: u32,
     lambertian: bool,
+    emissive: bool,
     sun: Option<[f32; 5]>,
     tile_mean: Vec<Vec3>,
     tile_se: Vec<Vec3>,
@@ -73,6 +78,7 @@ fn read_reference(name: &str) -> Reference {
         max_depth: int("max_depth"),
         tiles: int("tiles"),
         lambertian: s["lambertian"].as_bool().unwrap(),
+        emissive: s["emissive"].as_bool().unwrap_or(false),
         sun,
         tile_mean: vec3s(&v["tile_mean_rgb"]),
         tile_se: vec3s(&v["tile_mean_rgb_se"]),
@@ -90,6 +96,19 @@ fn make_lambertian(doc: &mut Value) {
         ext["KHR_materials_specular"] = json!({ "specularFactor": 0.0 });
     }
     declare(doc, "KHR_materials_specular");
+}
+
+/// Twin of mitsuba_reference.py's `make_emissive`: every material with a base colour texture emits
+/// it instead (the same textureInfo as emissiveTexture, emissiveFactor 1, base colour black).
+fn make_emissive(doc: &mut Value) {
+    for m in doc["materials"].as_array_mut().into_iter().flatten() {
+        let Some(texture) = m["pbrMetallicRoughness"].get("baseColorTexture").cloned() else {
+            continue;
+        };
+        m["emissiveTexture"] = texture;
+        m["emissiveFactor"] = json!([1.0, 1.0, 1.0]);
+        m["pbrMetallicRoughness"]["baseColorFactor"] = json!([0.0, 0.0, 0.0, 1.0]);
+    }
 }
 
 fn declare(doc: &mut Value, extension: &str) {
@@ -128,6 +147,9 @@ fn render(reference: &Reference, spp: u32) -> Image {
     let mut doc: Value = serde_json::from_slice(&std::fs::read(&reference.source).unwrap()).unwrap();
     if reference.lambertian {
         make_lambertian(&mut doc);
+    }
+    if reference.emissive {
+        make_emissive(&mut doc);
     }
     if let Some([x, y, z, e, env]) = reference.sun {
         add_sun(&mut doc, Vec3::new(x, y, z), e, env);
@@ -195,7 +217,9 @@ fn check(name: &str, delta: f32, spp: u32) -> Option<f32> {
         for c in 0..3 {
             let bound = Z * (se[c] * se[c] + rse[c] * rse[c]).sqrt() + delta * rm[c];
             let diff = (m[c] - rm[c]).abs();
-            worst = worst.max(diff / rm[c].max(1e-6));
+            if rm[c] >= BRIGHT {
+                worst = worst.max(diff / rm[c]);
+            }
             worst_se = worst_se.max(se[c] / rm[c].max(1e-6));
             worst_of_bound = worst_of_bound.max(diff / bound);
             if diff > bound {
@@ -207,7 +231,7 @@ fn check(name: &str, delta: f32, spp: u32) -> Option<f32> {
         }
     }
     eprintln!(
-        "{name}: worst tile {:.2}% from Mitsuba, {:.2} of its bound (model difference {:.0}%, restir-pt's largest relative standard error {:.2}%)",
+        "{name}: worst tile (channels >= 0.05) {:.2}% from Mitsuba, {:.2} of its bound (model difference {:.0}%, restir-pt's largest relative standard error {:.2}%)",
         100.0 * worst,
         worst_of_bound,
         100.0 * delta,
@@ -219,10 +243,12 @@ fn check(name: &str, delta: f32, spp: u32) -> Option<f32> {
 
 /// The samples' textures, texture transforms and samplers, camera and environment defaults,
 /// with one BSDF on both sides (Lambertian): TextureTransformTest and Avocado (normal-mapped,
-/// three 2048² textures) in the default uniform environment.
+/// three 2048² textures) in the default uniform environment, and TextureTransformTest's
+/// textures as emission (`make_emissive`; the file then has light, so no environment).
 #[test]
 fn independent_renderer_lambertian_samples_match_mitsuba() {
-    check("TextureTransformTest-lambertian", SAME_MODEL, SPP);
+    check("TextureTransformTest-lambertian", SAME_MODEL, 4 * SPP);
+    check("TextureTransformTest-emissive", SAME_MODEL, 4 * SPP);
     check("Avocado-lambertian", SAME_MODEL, SPP);
 }
 
