@@ -85,7 +85,7 @@ fn read_reference(name: &str) -> Reference {
     }
 }
 
-/// Twin of mitsuba_reference.py's `make_lambertian`: every material a Lambertian of its base
+/// Twin of tools/gltf_reader.py's `make_lambertian`: every material a Lambertian of its base
 /// colour (metallic 0, no metallic-roughness texture, KHR_materials_specular specularFactor 0).
 fn make_lambertian(doc: &mut Value) {
     for m in doc["materials"].as_array_mut().into_iter().flatten() {
@@ -98,7 +98,7 @@ fn make_lambertian(doc: &mut Value) {
     declare(doc, "KHR_materials_specular");
 }
 
-/// Twin of mitsuba_reference.py's `make_emissive`: every material with a base colour texture emits
+/// Twin of tools/gltf_reader.py's `make_emissive`: every material with a base colour texture emits
 /// it instead (the same textureInfo as emissiveTexture, emissiveFactor 1, base colour black).
 fn make_emissive(doc: &mut Value) {
     for m in doc["materials"].as_array_mut().into_iter().flatten() {
@@ -118,7 +118,7 @@ fn declare(doc: &mut Value, extension: &str) {
     }
 }
 
-/// Twin of mitsuba_reference.py's `add_sun`: a directional light of irradiance `e` shining along
+/// Twin of tools/gltf_reader.py's `add_sun`: a directional light of irradiance `e` shining along
 /// `dir` (a node whose -Z is rotated onto it) and the scene's constant environment `env`.
 fn add_sun(doc: &mut Value, dir: Vec3, e: f32, env: f32) {
     let q = Quat::from_rotation_arc(-Vec3::Z, dir.normalize());
