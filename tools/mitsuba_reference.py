@@ -91,8 +91,8 @@ class Materials:
     def bsdf(self, m):
         """The BSDF dict of glTF material `m` (None: the glTF default material)."""
         if m is None:
-            return {"type": "principled", "base_color": {"type": "rgb", "value": [1, 1, 1]},
-                    "metallic": 1.0, "roughness": 1.0}
+            return {"type": "twosided", "bsdf": {"type": "principled", "base_color": {"type": "rgb", "value": [1, 1, 1]},
+                                                 "metallic": 1.0, "roughness": 1.0}}
         pbr = m.pbrMetallicRoughness
         ext = m.extensions or {}
         factor = np.array(pbr.baseColorFactor if pbr and pbr.baseColorFactor else [1, 1, 1, 1], np.float64)
@@ -131,6 +131,12 @@ class Materials:
             bsdf = {"type": "normalmap", "normalmap": self.bitmap(m.normalTexture, (n + 1.0) * 0.5), "bsdf": bsdf}
         if m.alphaMode not in (None, "OPAQUE"):
             warn("material %r: alphaMode %s rendered opaque" % (m.name, m.alphaMode))
+        if bsdf.get("spec_trans", 0.0) == 0.0:
+            # restir-pt's opaque lobes reflect on whichever side the viewer is (materials.md,
+            # "Sides"); Mitsuba's reflect on the front only.
+            bsdf = {"type": "twosided", "bsdf": bsdf}
+        if m.doubleSided and max(m.emissiveFactor or [0]) > 0:
+            warn("material %r: double-sided emission; Mitsuba's area emitter emits from the front only" % m.name)
         return bsdf
 
     def emission(self, m):

@@ -7,14 +7,14 @@
 //! A tile passes when |restir-pt − Mitsuba| ≤ Z · sqrt(se_r² + se_m²) + δ · Mitsuba in every
 //! channel: se_r is the standard error of restir-pt's tile mean (its pixels' variances of the
 //! mean, pixels independent), se_m that of Mitsuba's over its 16 independent passes, Z = 4.5
-//! (two-sided p = 6.8e-6 per comparison; over the 48 comparisons of a scene and the 5 scenes,
-//! a false failure has probability below 0.2% by Bonferroni), and δ the model difference:
+//! (two-sided p = 6.8e-6 per comparison; over the 432 comparisons of the six scenes, a false
+//! failure has probability below 0.3% by Bonferroni), and δ the model difference:
 //! - 1% where both renderers evaluate the same BSDF (`make_lambertian`: every material a
 //!   Lambertian of its textured base colour, Mitsuba's `diffuse`; `make_emissive`: the base
-//!   colour texture as emission); measured worst 0.4% at 128 x 128 and 64 spp;
+//!   colour texture as emission); measured worst bright tile 0.4% at 128 x 128 with 64 spp;
 //! - 15% on the files as published, whose non-metals Mitsuba renders with its `principled` BSDF
-//!   (Burley's diffuse, whose retro-reflection makes the albedo of a white rough base 1.048 at
-//!   normal view, against the glTF specification's 0.974 and restir-pt's 0.974;
+//!   (Burley's diffuse, whose retro-reflection makes the albedo of a white base of roughness 1
+//!   1.048 seen at cos 0.894, against the glTF specification's 0.972 and restir-pt's 0.973;
 //!   docs/independent-check.md); measured worst 12%.
 
 use std::path::PathBuf;
