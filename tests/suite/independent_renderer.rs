@@ -11,7 +11,7 @@
 //! failure has probability below 0.3% by Bonferroni), and δ the model difference:
 //! - 1% where both renderers evaluate the same BSDF (`make_lambertian`: every material a
 //!   Lambertian of its textured base colour, Mitsuba's `diffuse`; `make_emissive`: the base
-//!   colour texture as emission); measured worst bright tile 0.4% at 128 x 128 with 64 spp;
+//!   colour texture as emission); measured worst bright tile 0.7% at 128 x 128 with 64 spp;
 //! - 15% on the files as published, whose non-metals Mitsuba renders with its `principled` BSDF
 //!   (Burley's diffuse, whose retro-reflection makes the albedo of a white base of roughness 1
 //!   1.048 seen at cos 0.894, against the glTF specification's 0.972 and restir-pt's 0.973;
