@@ -14,6 +14,7 @@ mod dielectric_furnace;
 mod furnace;
 mod gris;
 mod gris_oracle;
+mod independent_renderer;
 mod layout;
 mod normal_mapped_scene;
 mod punctual;
