@@ -8,6 +8,13 @@
 #include "ray_offset.glsl"
 #include "types.glsl"
 
+#ifndef SCENE_ALPHA
+#define SCENE_ALPHA 0
+#endif
+#if SCENE_ALPHA
+#include "alpha.glsl"
+#endif
+
 const uint NO_HIT = 0xffffffffu;
 
 struct Hit {
@@ -52,7 +59,8 @@ vec3 safe_inverse(vec3 d) {
     return vec3(d.x != 0.0 ? 1.0 / d.x : big, d.y != 0.0 ? 1.0 / d.y : big, d.z != 0.0 ? 1.0 / d.z : big);
 }
 
-// Closest hit when any_hit is false; the first hit found otherwise (shadow rays). Stackless: the
+// Closest hit when any_hit is false; the first hit found otherwise (shadow rays). With
+// SCENE_ALPHA, hits that alpha_keeps rejects do not count. Stackless: the
 // uniform control flow suits SIMD CPUs (lavapipe) and keeps register pressure low on GPUs.
 Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     Hit hit;
@@ -86,7 +94,11 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
             count_subgroup(COUNTER_TRIANGLE_ITERATIONS);
             float t;
             vec2 bary;
-            if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)) {
+            if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)
+#if SCENE_ALPHA
+                && alpha_keeps(i, bary, o, d)
+#endif
+            ) {
                 hit.t = t;
                 hit.triangle = i;
                 hit.bary = bary;

@@ -87,6 +87,17 @@ vec3 normal_mapped(uint material, SurfaceHit s) {
 #endif
 }
 
+#if SCENE_TEXTURES
+// The opacity of material `material` at s: baseColorFactor's alpha times the base colour
+// texture's (linear) alpha.
+float material_alpha(uint material, SurfaceHit s) {
+    TextureSlot slot = material_textures[material].base_color;
+    float a = material_textures[material].base_alpha;
+    if (slot.texture_index == NO_TEXTURE) return a;
+    return a * texture_lookup(slot.texture_index, texture_coordinates(slot, s), true).a;
+}
+#endif
+
 // The material of triangle index `triangle` at barycentrics bary, textures applied.
 Material material_at(uint triangle, vec2 bary) {
     uint material = triangles[triangle].material;

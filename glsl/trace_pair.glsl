@@ -36,10 +36,18 @@ void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded)
         Triangle tri = triangles[i];
         float t;
         vec2 bary;
-        if (intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)) {
+        if (intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)
+#if SCENE_ALPHA
+            && alpha_keeps(i, bary, closest.origin, closest.dir)
+#endif
+        ) {
             hit = Hit(t, i, bary);
         }
-        occluded = intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary) || occluded;
+        occluded = (intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary)
+#if SCENE_ALPHA
+            && alpha_keeps(i, bary, shadow.origin, shadow.dir)
+#endif
+            ) || occluded;
     }
     note_loop_exit(i < triangle_count);
 }
@@ -81,10 +89,18 @@ void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded)
             Triangle tri = triangles[i];
             float t;
             vec2 bary;
-            if (enter_c && intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)) {
+            if (enter_c && intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)
+#if SCENE_ALPHA
+                && alpha_keeps(i, bary, closest.origin, closest.dir)
+#endif
+            ) {
                 hit = Hit(t, i, bary);
             }
-            occluded = (enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary)) || occluded;
+            occluded = (enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary)
+#if SCENE_ALPHA
+                && alpha_keeps(i, bary, shadow.origin, shadow.dir)
+#endif
+                ) || occluded;
         }
         note_loop_exit(i < last);
         // An occluded shadow ray is done, and so is the lane if it has no closest ray.

@@ -245,6 +245,10 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
         ("SCENE_SHADING_NORMALS", flag(scene.has_shading_normals())),
     ];
+    // Only scenes that alpha-test define it: opaque scenes keep their kernels' code unchanged.
+    if scene.alpha().is_some() {
+        defines.push(("SCENE_ALPHA", "1".to_string()));
+    }
     if uniform {
         defines.extend([
             ("SCENE_TRIANGLE_COUNT", scene.triangles.len().max(1).to_string()),

@@ -129,6 +129,36 @@ pub fn cornell() -> String {
     b.finish("cornell", Vec3::ZERO)
 }
 
+/// The Cornell box with a horizontal white screen under the light (y = 0.55, x and z in
+/// [-0.7, 0.7], facing down) cut out by `mask_png` (alphaMode MASK, cutoff 0.5, nearest
+/// filtering, repeated 5 times each way): light reaches the room through its holes and shifted
+/// paths must see the same holes. Not a bundled file; tests of alpha testing build it.
+pub fn cornell_alpha_screen(mask_png: &[u8]) -> String {
+    use crate::scene::gltf_writer::{FILTER_NEAREST, WRAP_REPEAT};
+    let mut b = GltfBuilder::default();
+    cornell_room(&mut b, CORNELL_LIGHT, CORNELL_LIGHT_SIZE);
+    let white = b.material("box white", MaterialSpec::diffuse(WHITE));
+    cornell_boxes(&mut b, white, white);
+    let screen = b.material("masked screen", MaterialSpec::diffuse(WHITE));
+    let texture = b.texture(mask_png, "image/png", [WRAP_REPEAT, WRAP_REPEAT], FILTER_NEAREST);
+    b.set_material_field(
+        screen,
+        &["pbrMetallicRoughness", "baseColorTexture"],
+        serde_json::json!({ "index": texture }),
+    );
+    b.set_material_field(screen, &["alphaMode"], serde_json::json!("MASK"));
+    let quad = MeshData::quad(Vec3::new(-0.7, 0.55, -0.7), Vec3::X * 1.4, Vec3::Z * 1.4);
+    let uv: Vec<glam::Vec2> = quad
+        .positions
+        .iter()
+        .map(|p| glam::Vec2::new(p.x + 0.7, p.z + 0.7) * (5.0 / 1.4))
+        .collect();
+    let mesh = b.mesh_with_attributes("masked screen", &quad, None, &[&uv], screen);
+    b.instance("masked screen", mesh, 0.0, Vec3::ZERO);
+    cornell_camera_path(&mut b);
+    b.finish("cornell with a masked screen", Vec3::ZERO)
+}
+
 /// Scene 2: The Cornell box with five GGX conductor spheres at roughness 0.05 to 0.5, straddling the
 /// reconnection roughness threshold (0.2).
 pub fn cornell_glossy() -> String {

@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::gpu_types::{BvhNode, Triangle, LEAF_COUNT_BITS, LEAF_COUNT_MASK};
+use crate::shading::alpha::{alpha_keeps, AlphaScene};
 use crate::shading::ray_offset::offset_ray_origin;
 
 pub const NO_HIT: u32 = u32::MAX;
@@ -232,8 +233,18 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
     Vec3::new(inv(d.x), inv(d.y), inv(d.z))
 }
 
-/// Twin of GLSL `bvh_traverse`: closest hit, or the first hit found when `any_hit`.
-pub fn bvh_traverse(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3, tmax: f32, any_hit: bool) -> Hit {
+/// Twin of GLSL `bvh_traverse`: closest hit, or the first hit found when `any_hit`. With
+/// `alpha` (the kernels' `SCENE_ALPHA`), hits that `alpha_keeps` rejects do not count.
+pub fn bvh_traverse(
+    nodes: &[BvhNode],
+    triangles: &[Triangle],
+    alpha: Option<&AlphaScene>,
+    o: Vec3,
+    d: Vec3,
+    tmax: f32,
+    any_hit: bool,
+) -> Hit {
+    let keeps = |i: u32, bary: Vec2| alpha.is_none_or(|a| alpha_keeps(a, triangles, i, bary, o, d));
     let mut hit = Hit {
         t: tmax,
         triangle: NO_HIT,
@@ -254,7 +265,7 @@ pub fn bvh_traverse(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3,
             continue;
         }
         for i in first..first + count {
-            if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t) {
+            if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t).filter(|&(_, b)| keeps(i, b)) {
                 hit = Hit { t, triangle: i, bary };
                 if any_hit {
                     return hit;
@@ -266,12 +277,15 @@ pub fn bvh_traverse(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3,
     hit
 }
 
+/// The closest hit of the ray (o, d) before tmax, every surface opaque (`bvh_traverse` with
+/// [`crate::scene::Scene::alpha`] honours alpha modes).
 pub fn trace_closest(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3, tmax: f32) -> Hit {
-    bvh_traverse(nodes, triangles, o, d, tmax, false)
+    bvh_traverse(nodes, triangles, None, o, d, tmax, false)
 }
 
+/// Whether anything blocks the ray (o, d) before tmax, every surface opaque.
 pub fn trace_occluded(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec3, tmax: f32) -> bool {
-    bvh_traverse(nodes, triangles, o, d, tmax, true).triangle != NO_HIT
+    bvh_traverse(nodes, triangles, None, o, d, tmax, true).triangle != NO_HIT
 }
 
 /// Segment tests stop this fraction short of their (offset) end point.
@@ -305,8 +319,17 @@ pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 64;
 /// anything blocks `shadow`, in one traversal of the BVH (or, with `brute_force`, one pass over
 /// every triangle in index order, the closest hit being the first of equal distances). The BVH
 /// form tests each ray against the same triangles in the same order as `bvh_traverse`, so its
-/// results equal `trace_closest` and `trace_occluded` bit for bit.
-pub fn trace_pair(nodes: &[BvhNode], triangles: &[Triangle], brute_force: bool, closest: PairRay, shadow: PairRay) -> (Hit, bool) {
+/// results equal `trace_closest` and `trace_occluded` bit for bit. With `alpha` (`SCENE_ALPHA`)
+/// each ray skips the hits `alpha_keeps` rejects for it.
+pub fn trace_pair(
+    nodes: &[BvhNode],
+    triangles: &[Triangle],
+    alpha: Option<&AlphaScene>,
+    brute_force: bool,
+    closest: PairRay,
+    shadow: PairRay,
+) -> (Hit, bool) {
+    let keeps = |i: usize, bary: Vec2, ray: &PairRay| alpha.is_none_or(|a| alpha_keeps(a, triangles, i as u32, bary, ray.origin, ray.dir));
     let mut hit = Hit {
         t: closest.tmax,
         triangle: NO_HIT,
@@ -316,7 +339,7 @@ pub fn trace_pair(nodes: &[BvhNode], triangles: &[Triangle], brute_force: bool, 
     let test = |i: usize, enter_c: bool, enter_s: bool, hit: &mut Hit, occluded: &mut bool| {
         let tri = &triangles[i];
         if enter_c {
-            if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, hit.t) {
+            if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, hit.t).filter(|&(_, b)| keeps(i, b, &closest)) {
                 *hit = Hit {
                     t,
                     triangle: i as u32,
@@ -324,7 +347,7 @@ pub fn trace_pair(nodes: &[BvhNode], triangles: &[Triangle], brute_force: bool, 
                 };
             }
         }
-        *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some();
+        *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some_and(|(_, b)| keeps(i, b, &shadow));
     };
     if brute_force {
         for i in 0..triangles.len() {

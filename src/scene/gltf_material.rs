@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use super::gltf_loader::{problem, Loader};
 use crate::gpu_types::{Material, MATERIAL_DOUBLE_SIDED};
+use crate::shading::texture::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
 
 /// Specular reflectance at normal incidence of dielectrics in the metallic-roughness model.
 const DIELECTRIC_F0: f32 = 0.04;
@@ -43,6 +44,43 @@ pub fn spec_gloss_to_metal_rough(diffuse: Vec3, specular: Vec3, glossiness: f32)
 }
 
 impl Loader<'_> {
+    /// The alpha mode (`ALPHA_*`) and cutoff traversal applies to material `m`. An emitter
+    /// (emissive factor or unlit) stays opaque, with a warning: light sampling picks points on
+    /// the whole triangle, so a cut-out emitter would still light the scene through its holes.
+    /// A cutoff outside [0, 1] is usable (below 0 every hit counts, above 1 none does) and warned
+    /// about; it is kept as written.
+    pub(super) fn alpha_test(&mut self, m: &gltf::Material) -> (u32, f32) {
+        use gltf::material::AlphaMode;
+        let name = m
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0)));
+        let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+        let mode = m.alpha_mode();
+        if mode == AlphaMode::Opaque {
+            return (ALPHA_OPAQUE, cutoff);
+        }
+        let emits = m.unlit() || m.emissive_factor().iter().any(|&c| c > 0.0) && m.emissive_strength().unwrap_or(1.0) > 0.0;
+        if emits {
+            self.warn(format!(
+                "{name}: alpha mode {mode:?} ignored on an emissive material (emitters are opaque)"
+            ));
+            return (ALPHA_OPAQUE, cutoff);
+        }
+        if mode == AlphaMode::Blend {
+            return (ALPHA_BLEND, cutoff);
+        }
+        if !(0.0..=1.0).contains(&cutoff) {
+            let effect = if cutoff > 1.0 {
+                "no part of it is rendered"
+            } else {
+                "it is rendered opaque"
+            };
+            self.warn(format!("{name}: alphaCutoff {cutoff} is outside [0, 1]; {effect}"));
+        }
+        (ALPHA_MASK, cutoff)
+    }
+
     pub(super) fn load_materials(&mut self) -> Result<()> {
         let doc = self.doc;
         let mut spec_gloss = 0;
@@ -100,9 +138,6 @@ impl Loader<'_> {
 
     fn convert_material(&mut self, m: &gltf::Material, name: &str) -> Result<Material> {
         self.warn_ignored_textures(m, name);
-        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
-            self.warn(format!("{name}: alpha mode {:?} ignored (rendered opaque)", m.alpha_mode()));
-        }
         if m.volume().is_some() {
             self.warn(format!("{name}: KHR_materials_volume ignored (no participating media)"));
         }

@@ -9,8 +9,8 @@ use anyhow::{bail, Result};
 
 use super::gltf_loader::{problem, Loader};
 use crate::shading::texture::{
-    texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE,
-    TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
+    texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP,
+    TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
 };
 
 /// Textures larger than this on a side are halved until they fit (mipmaps are not built, so
@@ -121,14 +121,11 @@ impl Loader<'_> {
         out: &mut SceneTextures,
     ) -> Result<MaterialTextures> {
         let pbr = m.pbr_metallic_roughness();
+        let (alpha_mode, alpha_cutoff) = self.alpha_test(m);
         let mut t = MaterialTextures {
             normal_scale: 1.0,
-            alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
-            alpha_mode: match m.alpha_mode() {
-                gltf::material::AlphaMode::Opaque => ALPHA_OPAQUE,
-                gltf::material::AlphaMode::Mask => ALPHA_MASK,
-                gltf::material::AlphaMode::Blend => ALPHA_BLEND,
-            },
+            alpha_cutoff,
+            alpha_mode,
             base_alpha: pbr.base_color_factor()[3].clamp(0.0, 1.0),
             ..Default::default()
         };

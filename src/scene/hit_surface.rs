@@ -6,10 +6,21 @@ use glam::{Vec2, Vec3};
 
 use super::Scene;
 use crate::gpu_types::Material;
+use crate::shading::alpha::AlphaScene;
 use crate::shading::surface::{surface_at, SurfaceHit, TriangleSurface};
-use crate::shading::texture::{normal_mapped, textured_material, NO_TEXTURE};
+use crate::shading::texture::{normal_mapped, textured_material, ALPHA_OPAQUE, NO_TEXTURE};
 
 impl Scene {
+    /// What traversal needs to alpha-test hits (the kernels' `SCENE_ALPHA`); `None` when every
+    /// material is opaque.
+    pub fn alpha(&self) -> Option<AlphaScene<'_>> {
+        let any = self.textures.materials.iter().any(|t| t.alpha_mode != ALPHA_OPAQUE);
+        (any && !self.surfaces.is_empty()).then_some(AlphaScene {
+            surfaces: &self.surfaces,
+            textures: &self.textures,
+        })
+    }
+
     /// The surface of triangle `triangle` at barycentrics `bary` (flat where the scene has no
     /// attributes).
     pub fn surface_at(&self, triangle: u32, bary: Vec2) -> SurfaceHit {

@@ -3,6 +3,7 @@
 //! GLSL include (`bsdf` for glsl/bsdf.glsl, `shift` for glsl/shift.glsl, ...), and `gris` holds
 //! the reuse estimator the ReSTIR passes implement.
 
+pub mod alpha;
 pub mod bsdf;
 pub mod candidates;
 pub mod gris;

@@ -232,7 +232,8 @@ pub fn normal_mapped(t: &MaterialTextures, textures: &SceneTextures, s: &Surface
     }
 }
 
-/// The opacity at surface `s` (base colour factor alpha times the texture's alpha).
+/// The opacity at surface `s` (base colour factor alpha times the texture's alpha). Twin of
+/// GLSL `material_alpha(material, s)`, which reads `t` from the material texture table.
 pub fn material_alpha(t: &MaterialTextures, textures: &SceneTextures, s: &SurfaceHit) -> f32 {
     if t.base_color.texture_index == NO_TEXTURE {
         return t.base_alpha;

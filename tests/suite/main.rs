@@ -3,6 +3,8 @@
 
 mod common;
 
+mod alpha_images;
+mod alpha_oracle;
 mod bench_cli;
 mod bsdf_oracle;
 mod bvh_oracle;
@@ -11,6 +13,7 @@ mod cli;
 mod cli_behaviour;
 mod cli_measurement;
 mod dielectric_furnace;
+mod double_sided;
 mod furnace;
 mod gris;
 mod gris_oracle;

@@ -12,7 +12,7 @@
 use std::sync::atomic::AtomicBool;
 
 use restir_pt::render::{History, Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind};
-use restir_pt::scene::load_scene;
+use restir_pt::scene::{load_scene, Scene};
 
 use crate::common::{assert_clean, gpu, repo_path};
 
@@ -168,14 +168,19 @@ const EVERY_CONFIGURATION: &[(ShiftKind, ReuseMis)] = &[
 ];
 
 fn check_unbiased(test: Unbiasedness) {
+    let scene = load_scene(&repo_path(&format!("scenes/{}.gltf", test.scene))).unwrap();
+    check_unbiased_on(test, &scene);
+}
+
+/// `check_unbiased` on a scene built by the test (`test.scene` names it).
+fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
     let name = if test.static_camera {
         format!("{} (static camera)", test.scene)
     } else {
         test.scene.to_string()
     };
     let ctx = gpu();
-    let scene = load_scene(&repo_path(&format!("scenes/{}.gltf", test.scene))).unwrap();
-    let scene = SceneGpu::upload(&ctx, &scene).unwrap();
+    let scene = SceneGpu::upload(&ctx, scene).unwrap();
     let reference = blocks(&reference(&scene));
     let mut max_failing = max_failing_blocks(reference.len());
     if test.path_tracer_control {
@@ -337,4 +342,43 @@ fn restir_unbiased_veach_door() {
         configurations: EVERY_CONFIGURATION,
         base: RestirSettings::default(),
     });
+}
+
+/// The Cornell box whose light shines through a screen cut out by an alpha mask (half its
+/// texels below the cutoff), as ReSTIR PT's unbiasedness tests build it.
+fn alpha_masked_cornell() -> Scene {
+    let checker = crate::alpha_images::png_with_alphas([0.8, 0.4, 0.4, 0.8]);
+    let text = restir_pt::scene::bundled_scenes::cornell_alpha_screen(&checker);
+    let scene = restir_pt::scene::load_scene_from_bytes(text.as_bytes(), None, std::path::Path::new("cornell-alpha.gltf")).unwrap();
+    assert!(scene.alpha().is_some(), "the screen must be alpha-tested");
+    scene
+}
+
+fn check_alpha_masked_cornell(configurations: &'static [(ShiftKind, ReuseMis)]) {
+    check_unbiased_on(
+        Unbiasedness {
+            scene: "cornell with a masked screen",
+            renders: RENDERS,
+            candidates: 1,
+            reservoirs: 1,
+            path_tracer_control: false,
+            static_camera: false,
+            configurations,
+            base: RestirSettings::default(),
+        },
+        &alpha_masked_cornell(),
+    );
+}
+
+// Every shift's vertices and visibility tests must see the same holes in the screen. The hybrid
+// shift reconnects and replays; the other shifts are in the ignored test below.
+#[test]
+fn restir_unbiased_alpha_masked_cornell() {
+    check_alpha_masked_cornell(&[(ShiftKind::Hybrid, ReuseMis::GeneralizedBalance)]);
+}
+
+#[test]
+#[ignore = "minutes; run with --ignored (docs/restir.md)"]
+fn restir_unbiased_alpha_masked_cornell_every_shift() {
+    check_alpha_masked_cornell(EVERY_CONFIGURATION);
 }

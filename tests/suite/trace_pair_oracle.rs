@@ -92,7 +92,7 @@ fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairR
 fn assert_gpu_matches_twin(scene: &Scene, gpu_hits: &[(Hit, bool)], pairs: &[(PairRay, PairRay)], brute_force: bool) -> usize {
     let mut hits = 0;
     for (i, ((g, g_occluded), (c, s))) in gpu_hits.iter().zip(pairs).enumerate() {
-        let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, brute_force, *c, *s);
+        let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, None, brute_force, *c, *s);
         assert_eq!(g.triangle, h.triangle, "pair {i}: GLSL t {} vs Rust t {}", g.t, h.t);
         assert_eq!(*g_occluded, occluded, "pair {i}: occlusion");
         if h.triangle != NO_HIT {
@@ -151,8 +151,8 @@ fn trace_pair_twin_equals_single_ray_traversals() {
     for (scene, extent) in [(random_scene(3), 6.0), (random_scene(11), 2.0)] {
         let (mut ties, mut hits) = (0, 0);
         for (i, (c, s)) in random_pairs(12, Vec3::ZERO, extent).into_iter().enumerate() {
-            let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, false, c, s);
-            let (b, b_occluded) = trace_pair(&scene.nodes, &scene.triangles, true, c, s);
+            let (h, occluded) = trace_pair(&scene.nodes, &scene.triangles, None, false, c, s);
+            let (b, b_occluded) = trace_pair(&scene.nodes, &scene.triangles, None, true, c, s);
             if c.tmax > 0.0 {
                 let single = trace_closest(&scene.nodes, &scene.triangles, c.origin, c.dir, c.tmax);
                 assert_eq!(
