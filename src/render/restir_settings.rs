@@ -87,7 +87,10 @@ pub struct RestirSettings {
     pub shift: ShiftKind,
     pub mis: ReuseMis,
     pub temporal: bool,
-    /// Spatial neighbours per round; 0 turns spatial reuse off.
+    /// Spatial neighbours per round; 0 turns spatial reuse off. The default, 1, is the cheapest
+    /// spatial reuse: two shifts per pixel under either MIS (k neighbours cost k (k + 1) under
+    /// the generalized balance heuristic), and with a moving camera the one that beat spatial
+    /// reuse off at equal time (docs/lab-notebook.md, "Spatial reuse that pays").
     pub spatial: u32,
     pub radius: f32,
     pub rounds: u32,
@@ -118,7 +121,7 @@ impl Default for RestirSettings {
             shift: ShiftKind::Hybrid,
             mis: ReuseMis::GeneralizedBalance,
             temporal: true,
-            spatial: 3,
+            spatial: 1,
             radius: 20.0,
             rounds: 1,
             m_cap: 20.0,
