@@ -218,13 +218,33 @@ vec3 bsdf_eval_pdf(Material m, vec3 ng, vec3 ns, vec3 wo, vec3 wi, out float pdf
     return f_cos;
 }
 
+BsdfSample bsdf_sample_failed() { return BsdfSample(vec3(0.0), vec3(0.0), 0.0, LOBE_NONE); }
+
+// The smooth dielectric's delta sample from local wo in frame (t, b, n): reflection when u < the
+// Fresnel reflectance, else refraction; w_t is the lobe's weight.
+BsdfSample sample_smooth_dielectric(Material m, vec3 wo, float w_t, float u, vec3 t, vec3 b, vec3 n) {
+    BsdfSample s = bsdf_sample_failed();
+    float fr = fresnel_dielectric(wo.z, m.ior);
+    if (u < fr) {
+        s.wi = to_world(vec3(-wo.x, -wo.y, wo.z), t, b, n);
+        s.weight = m.base_color;
+        s.pdf = w_t * fr;
+        s.lobe = LOBE_DIELECTRIC | LOBE_DELTA;
+        return s;
+    }
+    vec3 wt;
+    float etap;
+    if (!refract_dir(wo, vec3(0.0, 0.0, 1.0), m.ior, wt, etap)) return s;
+    s.wi = to_world(wt, t, b, n);
+    s.weight = m.base_color / (etap * etap);
+    s.pdf = w_t * (1.0 - fr);
+    s.lobe = LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION;
+    return s;
+}
+
 // bsdf_sample in the frame of normal n alone (no side checks).
 BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
-    BsdfSample s;
-    s.wi = vec3(0.0);
-    s.weight = vec3(0.0);
-    s.pdf = 0.0;
-    s.lobe = LOBE_NONE;
+    BsdfSample s = bsdf_sample_failed();
     vec3 t, b;
     build_onb(n, t, b);
     vec3 wo = to_local(wo_world, t, b, n);
@@ -266,24 +286,7 @@ BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
             s.lobe = LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION;
             return s;
         }
-        if (alpha < DELTA_ALPHA) {
-            float fr = fresnel_dielectric(wo.z, m.ior);
-            if (u.w < fr) {
-                s.wi = to_world(vec3(-wo.x, -wo.y, wo.z), t, b, n);
-                s.weight = m.base_color;
-                s.pdf = w_t * fr;
-                s.lobe = LOBE_DIELECTRIC | LOBE_DELTA;
-            } else {
-                vec3 wt;
-                float etap;
-                if (!refract_dir(wo, vec3(0.0, 0.0, 1.0), m.ior, wt, etap)) return s;
-                s.wi = to_world(wt, t, b, n);
-                s.weight = m.base_color / (etap * etap);
-                s.pdf = w_t * (1.0 - fr);
-                s.lobe = LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION;
-            }
-            return s;
-        }
+        if (alpha < DELTA_ALPHA) return sample_smooth_dielectric(m, wo, w_t, u.w, t, b, n);
         // Visible normals are sampled from wo mirrored through the origin, as the pdf assumes.
         vec3 wm = sample_ggx_vndf(wo * side, alpha, u.xy);
         float fr = fresnel_dielectric(dot(wo, wm), m.ior);
@@ -315,14 +318,9 @@ BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
 // shading normal (unit). A sample on different sides of the two normals fails.
 BsdfSample bsdf_sample(Material m, vec3 ng, vec3 ns, vec3 wo_world, vec4 u) {
     vec3 n = shading_normal_facing(ng, ns);
-    BsdfSample s;
-    s.wi = vec3(0.0);
-    s.weight = vec3(0.0);
-    s.pdf = 0.0;
-    s.lobe = LOBE_NONE;
-    if (!sides_agree(ng, n, wo_world)) return s;
+    if (!sides_agree(ng, n, wo_world)) return bsdf_sample_failed();
     BsdfSample r = bsdf_sample_frame(m, n, wo_world, u);
-    if (r.lobe == LOBE_NONE || !sides_agree(ng, n, r.wi)) return s;
+    if (r.lobe == LOBE_NONE || !sides_agree(ng, n, r.wi)) return bsdf_sample_failed();
     return r;
 }
 

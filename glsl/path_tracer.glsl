@@ -13,6 +13,7 @@
 #include "lights.glsl"
 #include "punctual.glsl"
 #include "rng.glsl"
+#include "shading_frame.glsl"
 #include "trace_pair.glsl"
 
 const float RAY_TMAX = 1e30;
@@ -85,8 +86,11 @@ bool path_step(inout PathState s) {
         return false;
     }
     Triangle tri = triangles[hit.triangle];
-    Material m = material_at(hit.triangle, hit.bary);
     vec3 ng = normalize(cross(tri.e1, tri.e2));
+    // BSDFs see the shading normal ns; emission, light pdfs and ray offsets the geometric ng.
+    Material m;
+    vec3 ns;
+    hit_shading(hit.triangle, hit.bary, ng, m, ns);
     vec3 x = tri.v0 + hit.bary.x * tri.e1 + hit.bary.y * tri.e2;
     vec3 wo = -s.dir;
     if (SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER) {
@@ -100,7 +104,7 @@ bool path_step(inout PathState s) {
     LightSample ls = sample_light(x, ul.xyz);
     if (ls.pdf > 0.0 && max_component(ls.radiance) > 0.0) {
         float bsdf_pdf;
-        vec3 f = bsdf_eval_pdf(m, ng, ng, wo, ls.dir, bsdf_pdf);
+        vec3 f = bsdf_eval_pdf(m, ng, ns, wo, ls.dir, bsdf_pdf);
         if (max_component(f) > 0.0) {
             s.shadow = shadow_ray(x, ng, hit.triangle, ls);
             // BSDF sampling never reaches a punctual light: NEE alone estimates it.
@@ -111,7 +115,7 @@ bool path_step(inout PathState s) {
 
     // A path that ends here still traces its pending shadow ray in one more step.
     s.extend = false;
-    BsdfSample bs = bsdf_sample(m, ng, ng, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
+    BsdfSample bs = bsdf_sample(m, ng, ns, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
     if (bs.lobe == LOBE_NONE) return s.shadow.tmax > 0.0;
     s.beta *= bs.weight;
     s.prev_pdf = bs.pdf;

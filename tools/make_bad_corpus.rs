@@ -151,33 +151,28 @@ fn decode_base64(s: &str) -> Vec<u8> {
         .collect()
 }
 
-fn main() -> anyhow::Result<()> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");
-    let mut nan = floor();
-    nan.positions[1].x = f32::NAN;
-    let mut inf = floor();
-    inf.positions[2].z = f32::INFINITY;
-    let mut out_of_range = floor();
-    out_of_range.indices[5] = 1000;
-    let flat = MeshData {
-        positions: vec![Vec3::Y, Vec3::new(1.0, 1.0, 0.0), Vec3::new(2.0, 1.0, 0.0)],
-        indices: vec![0, 1, 2],
-    };
-    let degenerate = floor().merged(&MeshData {
-        positions: vec![Vec3::ZERO; 3],
-        indices: vec![0, 1, 2],
-    });
+/// A corpus file: its name in tests/data/bad/ and its bytes.
+type Case = (&'static str, Vec<u8>);
+
+/// glTF JSON cut off inside the scene list.
+const CUT_OFF_JSON: &[u8] = b"{ \"asset\": { \"version\": \"2.0\" }, \"scenes\": [ { \"nodes\": [0";
+
+/// Files that are not a readable glTF at all (and the valid binary one they are cut from).
+fn unreadable_files() -> anyhow::Result<Vec<Case>> {
     let valid = glb(base(floor(), lamp()));
-    let cases: Vec<(&str, Vec<u8>)> = vec![
+    Ok(vec![
         ("truncated.glb", valid[..valid.len() / 2].to_vec()),
         ("valid.glb", valid.clone()),
-        (
-            "bad-json.gltf",
-            b"{ \"asset\": { \"version\": \"2.0\" }, \"scenes\": [ { \"nodes\": [0".to_vec(),
-        ),
+        ("bad-json.gltf", CUT_OFF_JSON.to_vec()),
         ("not-gltf.gltf", b"this is not a glTF file\n".to_vec()),
         ("empty-file.gltf", Vec::new()),
         ("missing-bin.gltf", edited(|v| v["buffers"][0]["uri"] = json!("missing.bin"))),
+    ])
+}
+
+/// Valid glTF using features the loader handles or warns about.
+fn odd_but_usable() -> anyhow::Result<Vec<Case>> {
+    Ok(vec![
         ("strips-and-fans.gltf", serde_json::to_vec_pretty(&strips_and_fans())?),
         ("instanced.gltf", serde_json::to_vec_pretty(&instanced())?),
         ("vertex-colours.gltf", serde_json::to_vec_pretty(&vertex_colours())?),
@@ -217,6 +212,26 @@ fn main() -> anyhow::Result<()> {
                 v["extensionsRequired"] = json!(["EXT_meshopt_compression"]);
             }),
         ),
+    ])
+}
+
+/// Broken or degenerate geometry and out-of-range material values.
+fn bad_geometry_and_materials() -> anyhow::Result<Vec<Case>> {
+    let mut nan = floor();
+    nan.positions[1].x = f32::NAN;
+    let mut inf = floor();
+    inf.positions[2].z = f32::INFINITY;
+    let mut out_of_range = floor();
+    out_of_range.indices[5] = 1000;
+    let flat = MeshData {
+        positions: vec![Vec3::Y, Vec3::new(1.0, 1.0, 0.0), Vec3::new(2.0, 1.0, 0.0)],
+        indices: vec![0, 1, 2],
+    };
+    let degenerate = floor().merged(&MeshData {
+        positions: vec![Vec3::ZERO; 3],
+        indices: vec![0, 1, 2],
+    });
+    Ok(vec![
         (
             "warnings-then-error.gltf",
             edited(|v| {
@@ -267,6 +282,12 @@ fn main() -> anyhow::Result<()> {
                     .unwrap_or(())
             }),
         ),
+    ])
+}
+
+/// Broken document structure: extensions, references, scenes and node graphs.
+fn bad_structure() -> anyhow::Result<Vec<Case>> {
+    Ok(vec![
         (
             "unsupported-required-extension.gltf",
             edited(|v| {
@@ -295,45 +316,52 @@ fn main() -> anyhow::Result<()> {
             "accessor-overflow.gltf",
             edited(|v| v["accessors"][0]["count"] = json!(1_000_000_000u64)),
         ),
-        (
-            "absurd-node-count.gltf",
-            edited(|v| {
-                // Each node instances the next twice: 2^40 instances of the floor if walked naively.
-                let mut nodes: Vec<Value> = (0..40).map(|i| json!({ "children": [i + 1, i + 1] })).collect();
-                nodes.push(json!({ "mesh": 0 }));
-                let offset = v["nodes"].as_array().expect("nodes").len();
-                for n in nodes.iter_mut() {
-                    if let Some(c) = n.get_mut("children") {
-                        *c = json!(c
-                            .as_array()
-                            .expect("children")
-                            .iter()
-                            .map(|x| x.as_u64().expect("index") as usize + offset)
-                            .collect::<Vec<_>>());
-                    }
-                }
-                v["nodes"].as_array_mut().expect("nodes").extend(nodes);
-                v["scenes"][0]["nodes"].as_array_mut().expect("roots").push(json!(offset));
-            }),
-        ),
-        (
-            "deep-hierarchy.gltf",
-            edited(|v| {
-                let offset = v["nodes"].as_array().expect("nodes").len();
-                let chain: Vec<Value> = (0..400)
-                    .map(|i| {
-                        if i < 399 {
-                            json!({ "children": [offset + i + 1] })
-                        } else {
-                            json!({ "mesh": 0 })
-                        }
-                    })
-                    .collect();
-                v["nodes"].as_array_mut().expect("nodes").extend(chain);
-                v["scenes"][0]["nodes"].as_array_mut().expect("roots").push(json!(offset));
-            }),
-        ),
-    ];
+    ])
+}
+
+/// Each node instances the next twice: 2^40 instances of the floor if walked naively.
+fn absurd_node_count(v: &mut Value) {
+    let mut nodes: Vec<Value> = (0..40).map(|i| json!({ "children": [i + 1, i + 1] })).collect();
+    nodes.push(json!({ "mesh": 0 }));
+    let offset = v["nodes"].as_array().expect("nodes").len();
+    for n in nodes.iter_mut() {
+        if let Some(c) = n.get_mut("children") {
+            *c = json!(c
+                .as_array()
+                .expect("children")
+                .iter()
+                .map(|x| x.as_u64().expect("index") as usize + offset)
+                .collect::<Vec<_>>());
+        }
+    }
+    v["nodes"].as_array_mut().expect("nodes").extend(nodes);
+    v["scenes"][0]["nodes"].as_array_mut().expect("roots").push(json!(offset));
+}
+
+/// A chain of 400 nodes, each the only child of the one before, ending in the floor mesh.
+fn deep_hierarchy(v: &mut Value) {
+    let offset = v["nodes"].as_array().expect("nodes").len();
+    let chain: Vec<Value> = (0..400)
+        .map(|i| {
+            if i < 399 {
+                json!({ "children": [offset + i + 1] })
+            } else {
+                json!({ "mesh": 0 })
+            }
+        })
+        .collect();
+    v["nodes"].as_array_mut().expect("nodes").extend(chain);
+    v["scenes"][0]["nodes"].as_array_mut().expect("roots").push(json!(offset));
+}
+
+fn main() -> anyhow::Result<()> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");
+    let mut cases = unreadable_files()?;
+    cases.extend(odd_but_usable()?);
+    cases.extend(bad_geometry_and_materials()?);
+    cases.extend(bad_structure()?);
+    cases.push(("absurd-node-count.gltf", edited(absurd_node_count)));
+    cases.push(("deep-hierarchy.gltf", edited(deep_hierarchy)));
     for (name, bytes) in cases {
         let path = dir.join(name);
         std::fs::write(&path, bytes).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;

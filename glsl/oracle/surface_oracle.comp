@@ -1,7 +1,7 @@
 #version 460
 // Oracle kernel: surface_at, triangle_bary, texture_lookup, texture_coordinates,
-// textured_material and normal_mapped on a scene with attributes and textures
-// (twins: src/surface.rs, src/texture.rs). Everything is bound in set 0: the scene at 0-4,
+// textured_material, normal_mapped, shading_normal and hit_shading on a scene with attributes
+// and textures (twins: src/surface.rs, src/texture.rs, src/scene/hit_surface.rs). Everything is bound in set 0: the scene at 0-4,
 // the surface bindings at 5-8, then inputs and outputs.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
@@ -9,14 +9,14 @@ layout(local_size_x = 64) in;
 #define SURFACE_SET 0
 #define SURFACE_BINDING 5
 #include "../scene_bindings.glsl"
-#include "../texture.glsl"
+#include "../shading_frame.glsl"
 
 // Per item: (triangle bits, b1, b2, texture bits), (u, v, srgb, -), (point xyz, -).
 layout(std430, set = 0, binding = 9) readonly buffer Inputs { vec4 inputs[]; };
 layout(std430, set = 0, binding = 10) writeonly buffer Outputs { vec4 outputs[]; };
 layout(push_constant) uniform Push { uint count; };
 
-const uint OUT_ROWS = 8u;
+const uint OUT_ROWS = 10u;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -37,4 +37,9 @@ void main() {
     outputs[o + 5u] = vec4(m.emission, m.roughness);
     outputs[o + 6u] = vec4(normal_mapped(material, s), 0.0);
     outputs[o + 7u] = vec4(triangle_bary(triangles[tri], p), texture_coordinates(material_textures[material].base_color, s));
+    Material hm;
+    vec3 ns;
+    hit_shading(tri, a.yz, normalize(cross(triangles[tri].e1, triangles[tri].e2)), hm, ns);
+    outputs[o + 8u] = vec4(shading_normal(tri, a.yz), hm.roughness);
+    outputs[o + 9u] = vec4(ns, hm.metallic);
 }

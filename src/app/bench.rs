@@ -13,8 +13,7 @@ use clap::Args;
 use super::args::{DeviceArgs, SceneArgs, SizeArgs, Toggle};
 use super::{finish_device, load_with_options, open_device};
 use crate::metrics::median;
-use crate::render::{PathTracer, RenderSettings, TraversalCounters};
-use crate::scene::Scene;
+use crate::render::{PathTracer, RenderSettings, SceneGpu, SceneInfo, TraversalCounters};
 
 /// `restir-pt bench`.
 #[derive(Args, Debug, Clone)]
@@ -133,21 +132,23 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         russian_roulette: args.russian_roulette.on(),
         ..Default::default()
     };
-    settings.validate(&scene)?;
+    settings.validate(&SceneInfo::of(&scene))?;
     let stage_load = lap.lap();
     let runs = args.runs.max(1);
     let ctx = open_device(&args.device)?;
     let stage_device = lap.lap();
-    let mut tracer = PathTracer::with_counters(&ctx, &scene, &settings, args.counters)?;
+    let scene_gpu = SceneGpu::upload(&ctx, &scene)?;
+    let mut tracer = PathTracer::with_counters(&scene_gpu, &settings, args.counters)?;
     let Runs {
         rates,
         gpu_ms,
         cpu_rates,
         counters,
         stage_warm_up,
-    } = timed_runs(&mut tracer, &scene, &settings, runs, &mut lap)?;
+    } = timed_runs(&mut tracer, &settings, runs, &mut lap)?;
     let stage_timed_runs = lap.lap();
     drop(tracer);
+    drop(scene_gpu);
     finish_device(&ctx)?;
     let report = BenchReport {
         device: ctx.info.name.clone(),
@@ -189,19 +190,16 @@ struct Runs {
 
 /// One warm-up render (llvmpipe compiles the pipeline at its first dispatch), timed by `lap`,
 /// then `runs` timed renders with seeds 1..=runs.
-fn timed_runs(tracer: &mut PathTracer, scene: &Scene, settings: &RenderSettings, runs: u32, lap: &mut Stopwatch) -> Result<Runs> {
+fn timed_runs(tracer: &mut PathTracer, settings: &RenderSettings, runs: u32, lap: &mut Stopwatch) -> Result<Runs> {
     let never = AtomicBool::new(false);
     let (mut rates, mut gpu_ms, mut cpu_rates) = (Vec::new(), Vec::new(), Vec::new());
     let mut counters: Option<TraversalCounters> = None;
     let mut stage_warm_up = None;
     for run in 0..=runs {
-        tracer.restart(
-            scene,
-            &RenderSettings {
-                seed: run,
-                ..settings.clone()
-            },
-        )?;
+        tracer.restart(&RenderSettings {
+            seed: run,
+            ..settings.clone()
+        })?;
         let cpu0 = process_cpu_seconds();
         let stats = tracer.render(&|_| {}, &never)?;
         let cpu_s = process_cpu_seconds() - cpu0;

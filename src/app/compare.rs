@@ -19,7 +19,7 @@ use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path};
 use crate::image_io::read_exr;
 use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};
-use crate::render::{Image, RenderSettings, MAX_RESERVOIRS};
+use crate::render::{Image, RenderSettings, SceneGpu, SceneInfo, MAX_RESERVOIRS};
 use crate::scene::{camera_on_path, Scene};
 
 /// `restir-pt compare`.
@@ -113,7 +113,8 @@ impl Cost {
 const CALIBRATION_FRAMES: u32 = 8;
 
 pub(super) struct Run<'a> {
-    pub scene: &'a Scene,
+    /// Cameras of the scene, for the camera path.
+    pub camera_count: usize,
     pub settings: &'a RenderSettings,
     pub camera_path: bool,
     /// Samples per pixel of the reference, from its record.
@@ -133,7 +134,7 @@ impl Run<'_> {
     /// The camera of frame `frame`.
     pub(super) fn camera(&self, frame: u32) -> usize {
         if self.camera_path {
-            camera_on_path(self.settings.camera, frame, self.scene.cameras.len())
+            camera_on_path(self.settings.camera, frame, self.camera_count)
         } else {
             self.settings.camera
         }
@@ -146,10 +147,10 @@ impl Run<'_> {
             seed,
             ..self.settings.clone()
         };
-        renderer.reset(self.scene, &settings)?;
+        renderer.reset(&settings)?;
         let (mut times, mut failed, mut last) = (vec![], vec![], None);
         for f in 0..frames {
-            let (outcome, image) = renderer.frame(self.scene, &settings, self.camera(f), f)?;
+            let (outcome, image) = renderer.frame(&settings, self.camera(f), f)?;
             self.gpu_ms.set(self.gpu_ms.get() + outcome.gpu_ms);
             if f > 0 || frames == 1 {
                 times.push(outcome.gpu_ms);
@@ -260,7 +261,7 @@ pub(super) struct Setup {
 impl Setup {
     pub(super) fn run(&self, camera_path: bool) -> Run<'_> {
         Run {
-            scene: &self.scene,
+            camera_count: self.scene.cameras.len(),
             settings: &self.settings,
             camera_path,
             reference_spp: self.reference_spp,
@@ -297,7 +298,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
         camera: args.path.camera,
         ..Default::default()
     };
-    settings.validate(&scene)?;
+    settings.validate(&SceneInfo::of(&scene))?;
     for m in &methods {
         if let MethodSpec::Restir(r) = m {
             r.validate(settings.max_depth)?;
@@ -352,10 +353,11 @@ fn compare_all(args: &CompareArgs, setup: &Setup) -> Result<Vec<CompareRow>> {
     let run = setup.run(args.camera_path);
     note_camera_path(args, &run);
     let progress = status_spinner();
+    let scene = SceneGpu::upload(&ctx, &setup.scene)?;
     let mut renderers = vec![];
     for m in &setup.methods {
         progress.set_message(format!("compiling and calibrating {}", m.label()));
-        let mut renderer = MethodRenderer::new(&ctx, &setup.scene, &setup.settings, m)?;
+        let mut renderer = MethodRenderer::new(&scene, &setup.settings, m)?;
         let cost = run.calibrate(&mut renderer)?;
         progress.suspend(|| eprintln!("{}: {}", m.label(), cost.describe()));
         renderers.push((m.label(), renderer, cost));

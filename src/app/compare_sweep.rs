@@ -16,7 +16,7 @@ use super::sweep::{
 };
 use super::{finish_device, open_device};
 use crate::image_io::{read_exr, write_exr};
-use crate::render::Image;
+use crate::render::{Image, SceneGpu};
 
 const HEADER: &str = "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels";
 
@@ -53,7 +53,7 @@ fn run_job(args: &CompareArgs, setup: &Setup, k: usize, labels: &[String]) -> Re
     let ctx = open_device(&args.device)?;
     let run = setup.run(args.camera_path);
     note_camera_path(args, &run);
-    let mut renderer = MethodRenderer::new(&ctx, &setup.scene, &setup.settings, method)?;
+    let mut renderer = MethodRenderer::new(&SceneGpu::upload(&ctx, &setup.scene)?, &setup.settings, method)?;
     let mut cost = run.calibrate(&mut renderer)?;
     if let Some(most_ms) = run.extend(&mut renderer, &mut cost, budget)? {
         eprintln!("{}", reservoir_cap_note(&method.label(), most_ms));

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::args::{DeviceArgs, RestirArgs, SceneArgs};
 use super::{finish_device, load_with_options, open_device};
-use crate::render::{PathTracer, RenderSettings, Restir};
+use crate::render::{PathTracer, RenderSettings, Restir, SceneGpu};
 use crate::scene::Scene;
 use crate::vk::KernelCompile;
 
@@ -48,8 +48,10 @@ pub fn info(args: InfoArgs) -> Result<()> {
             max_depth: crate::shading::path_record::MAX_PATH_LENGTH as u32,
             ..Default::default()
         };
-        let mut reports = vec![PathTracer::new(&ctx, &scene, &settings)?.compile_report().clone()];
-        reports.extend(Restir::new(&ctx, &scene, &settings, &restir)?.compile_reports());
+        let scene_gpu = SceneGpu::upload(&ctx, &scene)?;
+        let mut reports = vec![PathTracer::new(&scene_gpu, &settings)?.compile_report().clone()];
+        reports.extend(Restir::new(&scene_gpu, &settings, &restir)?.compile_reports());
+        drop(scene_gpu);
         print_kernels(&restir.label(), &reports);
         finish_device(&ctx)?;
     }

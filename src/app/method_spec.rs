@@ -6,9 +6,7 @@ use std::sync::Arc;
 
 use anyhow::{bail, Result};
 
-use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
-use crate::scene::Scene;
-use crate::vk::Context;
+use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind, MAX_RESERVOIRS};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum MethodSpec {
@@ -95,18 +93,19 @@ pub struct FrameOutcome {
 }
 
 impl MethodRenderer {
-    pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, method: &MethodSpec) -> Result<Self> {
+    /// The renderer of `method` for the uploaded `scene` (shared, not uploaded again).
+    pub fn new(scene: &Arc<SceneGpu>, settings: &RenderSettings, method: &MethodSpec) -> Result<Self> {
         Ok(match method {
-            MethodSpec::PathTracing => MethodRenderer::PathTracing(Box::new(PathTracer::new(ctx, scene, settings)?), settings.spp),
-            MethodSpec::Restir(r) => MethodRenderer::Restir(Box::new(Restir::new(ctx, scene, settings, r)?)),
+            MethodSpec::PathTracing => MethodRenderer::PathTracing(Box::new(PathTracer::new(scene, settings)?), settings.spp),
+            MethodSpec::Restir(r) => MethodRenderer::Restir(Box::new(Restir::new(scene, settings, r)?)),
         })
     }
 
     /// Starts an independent sequence with `seed`: the path tracer's sums or ReSTIR's history
     /// are cleared.
-    pub fn reset(&mut self, scene: &Scene, settings: &RenderSettings) -> Result<()> {
+    pub fn reset(&mut self, settings: &RenderSettings) -> Result<()> {
         match self {
-            MethodRenderer::PathTracing(t, _) => t.restart(scene, settings),
+            MethodRenderer::PathTracing(t, _) => t.restart(settings),
             MethodRenderer::Restir(r) => r.reset(settings.seed),
         }
     }
@@ -152,19 +151,16 @@ impl MethodRenderer {
     /// One frame from `camera`: the knob's fresh paths per pixel for the path tracer (its frames
     /// share nothing), one ReSTIR PT frame (reusing the history) otherwise. The image is the
     /// frame alone.
-    pub fn frame(&mut self, scene: &Scene, settings: &RenderSettings, camera: usize, frame: u32) -> Result<(FrameOutcome, Image)> {
+    pub fn frame(&mut self, settings: &RenderSettings, camera: usize, frame: u32) -> Result<(FrameOutcome, Image)> {
         match self {
             MethodRenderer::PathTracing(t, spp) => {
                 // Distinct frames need distinct random numbers: the seed advances per frame.
-                t.restart(
-                    scene,
-                    &RenderSettings {
-                        camera,
-                        seed: settings.seed.wrapping_mul(0x9e37_79b9).wrapping_add(frame),
-                        spp: *spp,
-                        ..settings.clone()
-                    },
-                )?;
+                t.restart(&RenderSettings {
+                    camera,
+                    seed: settings.seed.wrapping_mul(0x9e37_79b9).wrapping_add(frame),
+                    spp: *spp,
+                    ..settings.clone()
+                })?;
                 let stats = t.render(&|_| {}, &AtomicBool::new(false))?;
                 let outcome = FrameOutcome {
                     gpu_ms: stats.gpu_ms,
@@ -173,7 +169,7 @@ impl MethodRenderer {
                 Ok((outcome, t.image()?))
             }
             MethodRenderer::Restir(r) => {
-                let stats = r.frame(scene, camera, false)?;
+                let stats = r.frame(camera, false)?;
                 let outcome = FrameOutcome {
                     gpu_ms: stats.gpu_ms().unwrap_or(stats.wall_ms),
                     failed_shift_rate: Some(stats.failed_shift_rate()),

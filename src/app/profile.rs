@@ -12,9 +12,8 @@ use super::args::{DeviceArgs, PathArgs, RestirArgs, SceneArgs, SizeArgs};
 use super::render_output::{compile_progress, print_compile_summary};
 use super::{finish_device, load_with_options, open_device};
 use crate::metrics::quantile;
-use crate::render::{RenderSettings, Restir, RestirSettings, PASS_NAMES};
-use crate::scene::{camera_on_path, Scene};
-use crate::vk::Context;
+use crate::render::{RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_NAMES};
+use crate::scene::camera_on_path;
 
 /// `restir-pt profile`.
 #[derive(Args, Debug, Clone)]
@@ -124,12 +123,12 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
         seed: args.path.seed,
         ..Default::default()
     };
-    settings.validate(&scene)?;
+    settings.validate(&SceneInfo::of(&scene))?;
     let restir = args.restir.settings();
     restir.validate(settings.max_depth)?;
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     let ctx = open_device(&args.device)?;
-    let times = pass_times(&ctx, &scene, &settings, &restir, &args)?;
+    let times = pass_times(&SceneGpu::upload(&ctx, &scene)?, &settings, &restir, &args)?;
     finish_device(&ctx)?;
     let motion = if args.camera_path { "moving camera" } else { "static camera" };
     let title = format!(
@@ -144,26 +143,21 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
 }
 
 /// Every frame's GPU ms per pass.
-fn pass_times(
-    ctx: &Arc<Context>,
-    scene: &Scene,
-    settings: &RenderSettings,
-    restir: &RestirSettings,
-    args: &ProfileArgs,
-) -> Result<Vec<[f64; 4]>> {
+fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirSettings, args: &ProfileArgs) -> Result<Vec<[f64; 4]>> {
+    let ctx = scene.ctx();
     if !ctx.info.timestamps_supported {
         bail!("{}: the device has no compute timestamps to profile with", ctx.info.name);
     }
     let spinner = compile_progress();
-    let mut renderer = Restir::with_progress(ctx, scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
+    let mut renderer = Restir::with_progress(scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
     spinner.finish_and_clear();
     print_compile_summary(&renderer.compile_reports());
     let mut times = vec![];
     for f in 0..args.frames {
         let stats = if args.camera_path {
-            renderer.frame(scene, camera_on_path(args.path.camera, f, scene.cameras.len()), false)?
+            renderer.frame(camera_on_path(args.path.camera, f, scene.info().cameras.len()), false)?
         } else {
-            renderer.frame(scene, args.path.camera, true)?
+            renderer.frame(args.path.camera, true)?
         };
         let Some(ms) = stats.pass_ms else {
             bail!("{}: a frame came back without pass times", ctx.info.name);

@@ -12,7 +12,7 @@ use super::render_output::{create_parent, interrupt_flag, progress_bar};
 use super::shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
 use super::{finish_device, load_with_warnings, open_device, scene_path};
 use crate::image_io::write_exr;
-use crate::render::{Image, PathTracer, RenderSettings, RenderStats};
+use crate::render::{Image, PathTracer, RenderSettings, RenderStats, SceneGpu, SceneInfo};
 
 /// `restir-pt reference`.
 #[derive(Args, Debug, Clone)]
@@ -66,10 +66,10 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
         camera: args.path.camera,
         ..Default::default()
     };
-    settings.validate(&scene)?;
+    settings.validate(&SceneInfo::of(&scene))?;
     create_parent(&args.out)?;
     let ctx = open_device(&args.device)?;
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &scene)?, &settings)?;
     tracer.start_at_sample(samples.start);
     let bar = progress_bar(settings.spp);
     let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt_flag())?;

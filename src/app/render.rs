@@ -15,9 +15,8 @@ use super::render_output::{
 };
 use super::{finish_device, load_with_options, open_device};
 use crate::image_io::Exposure;
-use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings};
+use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo};
 use crate::scene::{camera_on_path, Scene};
-use crate::vk::Context;
 
 /// The rendering method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -135,7 +134,7 @@ impl RenderArgs {
             russian_roulette: self.russian_roulette.is_none_or(Toggle::on),
             camera: self.path.camera,
         };
-        settings.validate(scene)?;
+        settings.validate(&SceneInfo::of(scene))?;
         if let Some(restir) = self.restir_settings() {
             restir.validate(settings.max_depth)?;
         }
@@ -189,8 +188,8 @@ fn output_paths(args: &RenderArgs, scene_path: &Path) -> Result<OutputPaths> {
 
 /// What both methods' frame loops need.
 struct Job<'a> {
-    ctx: &'a Arc<Context>,
-    scene: &'a Scene,
+    /// The uploaded scene both renderers are built from.
+    scene: &'a Arc<SceneGpu>,
     scene_path: &'a Path,
     args: &'a RenderArgs,
     settings: &'a RenderSettings,
@@ -218,7 +217,7 @@ impl Job<'_> {
         image: Option<&crate::render::Image>,
         interrupted: bool,
     ) -> Result<bool> {
-        println!("{}{line}", self.args.frame_prefix(frame, self.scene.cameras.len()));
+        println!("{}{line}", self.args.frame_prefix(frame, self.scene.info().cameras.len()));
         guard_nonfinite(self.args.allow_nonfinite, self.args.report.as_deref(), frame, report)?;
         let last = self.is_last(frame, interrupted);
         if let Some(image) = image {
@@ -232,7 +231,7 @@ impl Job<'_> {
 
     fn report(&self, method: String, spp: u32, frame_ms: f64, wall_ms: f64, compile_ms: f64) -> RenderReport {
         RenderReport {
-            device: self.ctx.info.name.clone(),
+            device: self.scene.ctx().info.name.clone(),
             scene: self.scene_path.display().to_string(),
             method,
             width: self.settings.width,
@@ -273,9 +272,9 @@ pub fn render(args: RenderArgs) -> Result<()> {
     }
     let settings = args.settings(&scene)?;
     let paths = output_paths(&args, &path)?;
+    let scene_gpu = SceneGpu::upload(&ctx, &scene)?;
     let job = Job {
-        ctx: &ctx,
-        scene: &scene,
+        scene: &scene_gpu,
         scene_path: &path,
         args: &args,
         settings: &settings,
@@ -306,7 +305,7 @@ fn render_path_traced(job: &Job) -> Result<RenderReport> {
     let interrupt = interrupt_flag();
     let spinner = compile_progress();
     spinner.set_message("pathtrace.comp");
-    let mut tracer = PathTracer::new(job.ctx, job.scene, settings)?;
+    let mut tracer = PathTracer::new(job.scene, settings)?;
     spinner.finish_and_clear();
     let compile_ms = tracer.compile_report().total_ms();
     print_compile_summary(std::slice::from_ref(tracer.compile_report()));
@@ -315,14 +314,11 @@ fn render_path_traced(job: &Job) -> Result<RenderReport> {
         if frame > 0 && args.static_camera {
             tracer.add_samples(settings.spp);
         } else if frame > 0 {
-            let camera = args.frame_camera(frame, job.scene.cameras.len());
-            tracer.restart(
-                job.scene,
-                &RenderSettings {
-                    camera,
-                    ..settings.clone()
-                },
-            )?;
+            let camera = args.frame_camera(frame, job.scene.info().cameras.len());
+            tracer.restart(&RenderSettings {
+                camera,
+                ..settings.clone()
+            })?;
         }
         let bar = progress_bar(tracer.target_spp());
         let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
@@ -351,7 +347,7 @@ fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
     let (args, settings) = (job.args, job.settings);
     let interrupt = interrupt_flag();
     let spinner = compile_progress();
-    let mut renderer = Restir::with_progress(job.ctx, job.scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
+    let mut renderer = Restir::with_progress(job.scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
     spinner.finish_and_clear();
     let compile_reports = renderer.compile_reports();
     print_compile_summary(&compile_reports);
@@ -359,7 +355,7 @@ fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
     let spp = restir.candidates * restir.reservoirs;
     let (mut frame_ms, mut frame) = (vec![], 0);
     loop {
-        let stats = renderer.frame(job.scene, args.frame_camera(frame, job.scene.cameras.len()), args.static_camera)?;
+        let stats = renderer.frame(args.frame_camera(frame, job.scene.info().cameras.len()), args.static_camera)?;
         let interrupted = interrupt.load(Ordering::Relaxed);
         frame_ms.push(stats.gpu_ms().unwrap_or(stats.wall_ms));
         let detail = RestirFrameReport::from_stats(frame + 1, &stats);

@@ -24,9 +24,8 @@ use super::sweep::{
 use super::{bundled_file, finish_device, load_with_warnings, open_device};
 use crate::app::charts::{write_line_chart, LineChart, Series};
 use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
-use crate::render::{PathTracer, RenderSettings};
+use crate::render::{PathTracer, RenderSettings, SceneGpu, SceneInfo};
 use crate::scene::{camera_on_path, Scene};
-use crate::vk::Context;
 
 /// `restir-pt stability`.
 #[derive(Args, Debug, Clone)]
@@ -109,23 +108,22 @@ pub struct StabilityRow {
 }
 
 /// Path-traced references of a scene's camera poses, made on first use.
-struct References<'a> {
+struct References {
     tracer: PathTracer,
-    scene: &'a Scene,
     settings: RenderSettings,
     images: HashMap<usize, Vec<Vec3>>,
     /// GPU ms of the references rendered.
     gpu_ms: f64,
 }
 
-impl References<'_> {
+impl References {
     fn get(&mut self, camera: usize) -> Result<&[Vec3]> {
         if !self.images.contains_key(&camera) {
             let settings = RenderSettings {
                 camera,
                 ..self.settings.clone()
             };
-            self.tracer.restart(self.scene, &settings)?;
+            self.tracer.restart(&settings)?;
             self.gpu_ms += self.tracer.render(&|_| {}, &AtomicBool::new(false))?.gpu_ms;
             self.images.insert(camera, self.tracer.image()?.mean);
         }
@@ -156,15 +154,14 @@ struct Setup {
 
 impl Setup {
     /// Path-traced references of `scene`'s poses, rendered on first use.
-    fn references<'a>(&self, ctx: &Arc<Context>, args: &StabilityArgs, scene: &'a Scene) -> Result<References<'a>> {
+    fn references(&self, args: &StabilityArgs, scene: &Arc<SceneGpu>) -> Result<References> {
         let settings = RenderSettings {
             spp: args.reference_spp,
             seed: args.seed ^ 0x5eed_0f5e,
             ..self.base.clone()
         };
         Ok(References {
-            tracer: PathTracer::new(ctx, scene, &settings)?,
-            scene,
+            tracer: PathTracer::new(scene, &settings)?,
             settings,
             images: HashMap::new(),
             gpu_ms: 0.0,
@@ -203,7 +200,7 @@ fn setup(args: &StabilityArgs) -> Result<Setup> {
     let mut scenes = vec![];
     for path in &paths {
         let scene = load_with_warnings(path)?;
-        base.validate(&scene).with_context(|| path.display().to_string())?;
+        base.validate(&SceneInfo::of(&scene)).with_context(|| path.display().to_string())?;
         scenes.push((scene_name(path), scene));
     }
     for m in &methods {
@@ -238,9 +235,10 @@ fn run_all(args: &StabilityArgs, setup: &Setup) -> Result<Vec<StabilityRow>> {
     let ctx = open_device(&args.device)?;
     let mut rows = vec![];
     for (name, scene) in &setup.scenes {
-        let mut references = setup.references(&ctx, args, scene)?;
+        let scene = SceneGpu::upload(&ctx, scene)?;
+        let mut references = setup.references(args, &scene)?;
         for method in &setup.methods {
-            rows.extend(run_method(&ctx, args, setup, name, scene, method, &mut references)?.0);
+            rows.extend(run_method(args, setup, name, &scene, method, &mut references)?.0);
         }
     }
     finish_device(&ctx)?;
@@ -250,11 +248,10 @@ fn run_all(args: &StabilityArgs, setup: &Setup) -> Result<Vec<StabilityRow>> {
 /// One method on one scene, static then moving camera. Returns the rows, their GPU ms and the
 /// renderer's kernel compile ms.
 fn run_method(
-    ctx: &Arc<Context>,
     args: &StabilityArgs,
     setup: &Setup,
     name: &str,
-    scene: &Scene,
+    scene: &Arc<SceneGpu>,
     method: &MethodSpec,
     references: &mut References,
 ) -> Result<(Vec<StabilityRow>, f64, f64)> {
@@ -262,14 +259,14 @@ fn run_method(
         spp: args.pt_spp,
         ..setup.base.clone()
     };
-    let mut renderer = MethodRenderer::new(ctx, scene, &settings, method)?;
+    let mut renderer = MethodRenderer::new(scene, &settings, method)?;
     let (mut rows, mut gpu_ms) = (vec![], 0.0);
     for motion in [CameraMotion::Static, CameraMotion::Moving] {
-        renderer.reset(scene, &settings)?;
+        renderer.reset(&settings)?;
         let mut previous: Option<Vec<Vec3>> = None;
         for frame in 0..args.frames {
-            let camera = motion.camera(frame, scene.cameras.len());
-            let (outcome, image) = renderer.frame(scene, &settings, camera, frame)?;
+            let camera = motion.camera(frame, scene.info().cameras.len());
+            let (outcome, image) = renderer.frame(&settings, camera, frame)?;
             gpu_ms += outcome.gpu_ms;
             let reference = references.get(camera)?;
             rows.push(StabilityRow {
@@ -300,8 +297,9 @@ fn run_job(args: &StabilityArgs, setup: &Setup, k: usize, out_dir: &Path) -> Res
     let (name, scene) = &setup.scenes[k / setup.methods.len()];
     let method = &setup.methods[k % setup.methods.len()];
     let ctx = open_device(&args.device)?;
-    let mut references = setup.references(&ctx, args, scene)?;
-    let (rows, gpu_ms, compile_ms) = run_method(&ctx, args, setup, name, scene, method, &mut references)?;
+    let scene = SceneGpu::upload(&ctx, scene)?;
+    let mut references = setup.references(args, &scene)?;
+    let (rows, gpu_ms, compile_ms) = run_method(args, setup, name, &scene, method, &mut references)?;
     let report = JobReport {
         job: k,
         jobs: labels.len(),

@@ -9,6 +9,7 @@ mod reservoir_layers;
 mod restir;
 mod restir_settings;
 mod scene_gpu;
+mod scene_info;
 mod settings;
 mod surface_gpu;
 
@@ -19,5 +20,6 @@ pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir};
 pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
 pub use scene_gpu::SceneGpu;
+pub use scene_info::SceneInfo;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};
 pub use surface_gpu::SurfaceGpu;

@@ -11,7 +11,6 @@ use super::image_readback::AccumReadback;
 use super::{Image, RenderSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
-use crate::scene::Scene;
 use crate::shader_interface::{PathTraceBinding, IMAGE_LOCAL_SIZE};
 use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
@@ -63,7 +62,8 @@ pub struct PathTracer {
     status: Buffer,
     /// The image and the dispatch status come back through it.
     readback: AccumReadback,
-    _scene_gpu: SceneGpu,
+    /// The scene the kernel's descriptors point at; kept alive with the renderer.
+    scene: Arc<SceneGpu>,
     timer: PassTimer,
     settings: RenderSettings,
     base_params: crate::gpu_types::FrameParams,
@@ -75,17 +75,21 @@ pub struct PathTracer {
 }
 
 impl PathTracer {
-    pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
-        Self::with_counters(ctx, scene, settings, false)
+    /// A path tracer of the uploaded `scene` on its device, its kernel compiled. Errors:
+    /// `settings` invalid for the scene (see `RenderSettings::validate`), an image too large
+    /// for one binding, or a failed allocation or compile.
+    pub fn new(scene: &Arc<SceneGpu>, settings: &RenderSettings) -> Result<Self> {
+        Self::with_counters(scene, settings, false)
     }
 
     /// Like `new`; with `counters` the kernel also counts rays, node visits, triangle tests and
     /// SIMD loop iterations (glsl/counters.glsl), which `render` returns in its stats.
-    pub fn with_counters(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, counters: bool) -> Result<Self> {
-        settings.validate(scene)?;
+    pub fn with_counters(scene: &Arc<SceneGpu>, settings: &RenderSettings, counters: bool) -> Result<Self> {
+        let ctx = scene.ctx();
+        settings.validate(scene.info())?;
         let pixels = settings.pixel_count() as u64;
         ctx.check_binding_size("the accumulation image", pixels * 16)?;
-        let scene_gpu = SceneGpu::upload(ctx, scene)?;
+        let scene_gpu = scene;
         let params = Buffer::new(
             ctx,
             "frame parameters",
@@ -98,13 +102,13 @@ impl PathTracer {
         let mut bindings = scene_gpu.bindings();
         bindings.extend(PathTraceBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
         let mut defines = scene_gpu.defines();
-        if scene_gpu.uniform && scene.triangles.len() <= BRUTE_FORCE_MAX_TRIANGLES {
+        if scene_gpu.uniform && scene.info().triangle_count <= BRUTE_FORCE_MAX_TRIANGLES {
             defines.push(("SCENE_BRUTE_FORCE", "1"));
         }
         if counters {
             defines.push(("TRAVERSAL_COUNTERS", "1"));
         }
-        let mut kernel = scene_gpu.kernel(ctx, "pathtrace.comp", &defines, bindings, 0)?;
+        let mut kernel = scene_gpu.kernel("pathtrace.comp", &defines, bindings, 0)?;
         let mut buffers = scene_gpu.buffers(&params);
         buffers.extend([
             PathTraceBinding::Accum.to(&accum),
@@ -128,9 +132,9 @@ impl PathTracer {
             status,
             readback: AccumReadback::new(ctx, settings.width, settings.height, STATUS_WORDS * 4)?,
             timer: PassTimer::new(ctx, 1)?,
-            base_params: settings.frame_params(scene),
+            base_params: settings.frame_params(scene.info()),
             settings: settings.clone(),
-            _scene_gpu: scene_gpu,
+            scene: scene.clone(),
             first_sample: 0,
             samples_done: 0,
             counters: counters.then(TraversalCounters::default),
@@ -139,8 +143,8 @@ impl PathTracer {
 
     /// Starts over with `settings` (another camera, seed, spp or depth) and cleared sums, keeping
     /// the compiled kernel; the resolution must stay the same.
-    pub fn restart(&mut self, scene: &Scene, settings: &RenderSettings) -> Result<()> {
-        settings.validate(scene)?;
+    pub fn restart(&mut self, settings: &RenderSettings) -> Result<()> {
+        settings.validate(self.scene.info())?;
         if (settings.width, settings.height) != (self.settings.width, self.settings.height) {
             anyhow::bail!(
                 "restart cannot change the resolution ({}x{} to {}x{})",
@@ -152,7 +156,7 @@ impl PathTracer {
         }
         self.accum.fill(0)?;
         self.accum_sq.fill(0)?;
-        self.base_params = settings.frame_params(scene);
+        self.base_params = settings.frame_params(self.scene.info());
         self.settings = settings.clone();
         self.first_sample = 0;
         self.samples_done = 0;

@@ -15,7 +15,6 @@ use super::reservoir_layers::ReservoirLayers;
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams};
-use crate::scene::Scene;
 use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
 use crate::vk::{Binding, Context, Kernel, KernelCompile, PassTimer};
@@ -27,7 +26,7 @@ mod record;
 const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
 /// Shared memory of one workgroup of the ReSTIR kernels: the path being built by each of its
-/// LOCAL_SIZE² invocations (glsl/shift.glsl, `path_vertices`, `path_lobes`, `path_weights`),
+/// LOCAL_SIZE² invocations (glsl/shift_path.glsl, `path_vertices`, `path_lobes`, `path_weights`),
 /// per vertex a 32-byte vertex, a lobe and a 16-byte weight row.
 const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
 
@@ -62,7 +61,7 @@ pub struct Restir {
     buffers: RestirBuffers,
     /// The image and the per-frame counters come back through it.
     readback: AccumReadback,
-    scene_gpu: SceneGpu,
+    scene_gpu: Arc<SceneGpu>,
     timer: PassTimer,
     settings: RenderSettings,
     restir: RestirSettings,
@@ -74,21 +73,23 @@ pub struct Restir {
 }
 
 impl Restir {
-    /// Uploads `scene`, builds every kernel a run can use and compiles them (see `warm_up`);
-    /// the time that took is in `compile_reports`.
-    pub fn new(ctx: &Arc<Context>, scene: &Scene, settings: &RenderSettings, restir: &RestirSettings) -> Result<Self> {
-        Self::with_progress(ctx, scene, settings, restir, &|_| {})
+    /// A ReSTIR PT renderer of the uploaded `scene` on its device: builds every kernel a run
+    /// can use and compiles them (see `warm_up`); the time that took is in `compile_reports`.
+    /// Errors: settings invalid for the scene, too little shared memory, a failed allocation or
+    /// compile.
+    pub fn new(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirSettings) -> Result<Self> {
+        Self::with_progress(scene, settings, restir, &|_| {})
     }
 
     /// `new`, telling `progress` the name of each kernel before the driver compiles it.
     pub fn with_progress(
-        ctx: &Arc<Context>,
-        scene: &Scene,
+        scene: &Arc<SceneGpu>,
         settings: &RenderSettings,
         restir: &RestirSettings,
         progress: &dyn Fn(&str),
     ) -> Result<Self> {
-        settings.validate(scene)?;
+        let ctx = scene.ctx();
+        settings.validate(scene.info())?;
         restir.validate(settings.max_depth)?;
         if ctx.info.max_compute_shared_memory < SHARED_BYTES {
             anyhow::bail!(
@@ -98,18 +99,18 @@ impl Restir {
             );
         }
         let buffers = RestirBuffers::new(ctx, settings.pixel_count() as u64, restir.reservoirs)?;
-        let scene_gpu = SceneGpu::upload(ctx, scene)?;
+        let scene_gpu = scene.clone();
         let stats_bytes = std::mem::size_of::<RestirStats>() as u64;
         let mut renderer = Self {
             ctx: ctx.clone(),
-            kernels: build_kernels(ctx, &scene_gpu, restir)?,
+            kernels: build_kernels(&scene_gpu, restir)?,
             buffers,
             readback: AccumReadback::new(ctx, settings.width, settings.height, stats_bytes)?,
             scene_gpu,
             timer: PassTimer::new(ctx, PASS_NAMES.len() as u32)?,
             settings: settings.clone(),
             restir: restir.clone(),
-            shift_params: ShiftParams::for_scene(scene),
+            shift_params: scene.info().shift_params,
             frame_index: 0,
             history: None,
             surface_slot: 0,
@@ -189,14 +190,14 @@ impl Restir {
     /// Renders one frame from the scene's camera `camera`, in one submission. With
     /// `accumulate` the frame is added to the running average (a static camera's offline
     /// mode); otherwise the average restarts.
-    pub fn frame(&mut self, scene: &Scene, camera: usize, accumulate: bool) -> Result<FrameStats> {
+    pub fn frame(&mut self, camera: usize, accumulate: bool) -> Result<FrameStats> {
         let start = Instant::now();
         let settings = RenderSettings {
             camera,
             ..self.settings.clone()
         };
-        settings.validate(scene)?;
-        let frame_params = settings.frame_params(scene);
+        settings.validate(self.scene_gpu.info())?;
+        let frame_params = settings.frame_params(self.scene_gpu.info());
         let plan = self.plan(&frame_params);
         self.write_params(&frame_params, &plan, accumulate)?;
         self.ctx
@@ -258,7 +259,7 @@ impl Restir {
 
 /// Every kernel a frame may run, indexed by `PassKernel as usize`, built for the scene's
 /// bindings and defines and for the shift and MIS of `restir`.
-fn build_kernels(ctx: &Arc<Context>, scene_gpu: &SceneGpu, restir: &RestirSettings) -> Result<Vec<Kernel>> {
+fn build_kernels(scene_gpu: &SceneGpu, restir: &RestirSettings) -> Result<Vec<Kernel>> {
     let mut layout = scene_gpu.bindings();
     layout.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
     let mut defines = scene_gpu.defines();
@@ -267,7 +268,7 @@ fn build_kernels(ctx: &Arc<Context>, scene_gpu: &SceneGpu, restir: &RestirSettin
     for kernel in PassKernel::ALL {
         let (file, extra) = kernel.source();
         let all: Vec<_> = defines.iter().chain(extra).copied().collect();
-        let mut k = scene_gpu.kernel(ctx, file, &all, layout.clone(), 4)?;
+        let mut k = scene_gpu.kernel(file, &all, layout.clone(), 4)?;
         if kernel == PassKernel::TemporalUnmoved {
             k.set_variant("(unmoved camera)");
         }

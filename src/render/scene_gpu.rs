@@ -1,5 +1,6 @@
-//! The scene's buffers (bindings 1-4 of glsl/scene_bindings.glsl) and the `#define`s that
-//! specialise scene kernels to what the scene contains.
+//! The uploaded scene: its buffers (bindings 1-4 of glsl/scene_bindings.glsl), the `#define`s
+//! that specialise scene kernels to what the scene contains, and the host data renderers read.
+//! Renderers are built from an `Arc<SceneGpu>` and share it, so one upload serves every method.
 //!
 //! Three layouts, chosen by size: uniform buffers (CPU devices, small scenes), storage buffers,
 //! and, when the triangles, BVH nodes or emitters exceed one binding's range
@@ -20,8 +21,14 @@ use crate::shading::texture::NO_TEXTURE;
 use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context, Kernel};
 
 use super::surface_gpu::SurfaceGpu;
+use super::SceneInfo;
 
+/// A scene on one device: made by [`SceneGpu::upload`], shared by `Arc` among the renderers
+/// (`PathTracer`, `Restir`) and oracle kernels that read it.
 pub struct SceneGpu {
+    ctx: Arc<Context>,
+    /// The host data of the scene these buffers hold.
+    info: SceneInfo,
     pub triangles: Buffer,
     pub nodes: Buffer,
     pub materials: Buffer,
@@ -47,7 +54,11 @@ fn address_record(ctx: &Arc<Context>, name: &str, array: &Buffer, length: usize)
 }
 
 impl SceneGpu {
-    pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
+    /// Uploads `scene`'s triangles, BVH nodes, materials, emitters (with the punctual lights'
+    /// and environment map's rows) and surface attributes and textures to `ctx`'s device.
+    /// Errors: a buffer the device cannot allocate or bind (out of memory, over a binding's
+    /// range), named with the scene's file and the array.
+    pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<Arc<Self>> {
         let source = scene.source.display();
         let upload = |name: &str, r: Result<Buffer, GpuError>| r.with_context(|| format!("{source}: uploading {name}"));
         let env_rows = scene.environment_map.as_ref().map(|m| m.gpu_rows()).unwrap_or_default();
@@ -101,7 +112,9 @@ impl SceneGpu {
         if addressed {
             defines.push(("SCENE_ADDRESSED", "1".to_string()));
         }
-        Ok(Self {
+        Ok(Arc::new(Self {
+            ctx: ctx.clone(),
+            info: SceneInfo::of(scene),
             triangles,
             nodes,
             materials: upload(
@@ -121,7 +134,17 @@ impl SceneGpu {
             addresses,
             surface: SurfaceGpu::upload(ctx, scene)?,
             defines,
-        })
+        }))
+    }
+
+    /// The device the buffers live on.
+    pub fn ctx(&self) -> &Arc<Context> {
+        &self.ctx
+    }
+
+    /// The host data of the uploaded scene (cameras, environment, counts).
+    pub fn info(&self) -> &SceneInfo {
+        &self.info
     }
 
     /// Whether the triangles, nodes and emitters are reached by device address.
@@ -166,15 +189,8 @@ impl SceneGpu {
     }
 
     /// Builds scene kernel glsl/`name` with set 0 `set0` (bound by the caller) and binds set 1.
-    pub fn kernel(
-        &self,
-        ctx: &Arc<Context>,
-        name: &str,
-        defines: &[(&str, &str)],
-        set0: Vec<BindingSlot>,
-        push_bytes: u32,
-    ) -> Result<Kernel> {
-        let kernel = Kernel::new(ctx, name, defines, &self.layout(set0), push_bytes)?;
+    pub fn kernel(&self, name: &str, defines: &[(&str, &str)], set0: Vec<BindingSlot>, push_bytes: u32) -> Result<Kernel> {
+        let kernel = Kernel::new(&self.ctx, name, defines, &self.layout(set0), push_bytes)?;
         if let Some(s) = &self.surface {
             kernel.bind(&s.bound())?;
         }
@@ -222,6 +238,7 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
         ("SCENE_SURFACE", flag(!scene.surfaces.is_empty())),
         ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
+        ("SCENE_SHADING_NORMALS", flag(scene.has_shading_normals())),
     ];
     if uniform {
         defines.extend([

@@ -3,8 +3,9 @@
 use anyhow::{bail, Result};
 
 use crate::gpu_types::{FrameParams, FLAG_RUSSIAN_ROULETTE};
-use crate::scene::Scene;
 use crate::shading::path_record::MAX_PATH_LENGTH;
+
+use super::SceneInfo;
 
 /// Sides beyond this are refused: per-pixel indices stay far inside u32, and 8x8 workgroups
 /// stay within 8192 per axis, below the 65535 every Vulkan device supports.
@@ -45,7 +46,10 @@ impl RenderSettings {
     /// methods.
     pub const DEFAULT_MAX_DEPTH: u32 = MAX_PATH_LENGTH as u32;
 
-    pub fn validate(&self, scene: &Scene) -> Result<()> {
+    /// Checks the image size, spp, depth and camera against `scene` (from
+    /// [`SceneInfo::of`] before upload, or [`SceneGpu::info`](super::SceneGpu::info)). Errors:
+    /// one line naming the bad value (and the scene's file for a missing camera).
+    pub fn validate(&self, scene: &SceneInfo) -> Result<()> {
         let (w, h) = (self.width, self.height);
         if w == 0 || h == 0 {
             bail!("resolution {w}x{h} is empty: width and height must be at least 1");
@@ -75,7 +79,8 @@ impl RenderSettings {
     }
 
     /// The frame parameters for this render, before the per-dispatch sample range is set.
-    pub fn frame_params(&self, scene: &Scene) -> FrameParams {
+    /// `self.camera` must index `scene.cameras` (see `validate`).
+    pub fn frame_params(&self, scene: &SceneInfo) -> FrameParams {
         let mut params = FrameParams {
             scene_env: scene.environment.extend(scene.env_select_prob).into(),
             width: self.width,
@@ -83,7 +88,7 @@ impl RenderSettings {
             max_depth: self.max_depth,
             render_seed: self.seed,
             flags: if self.russian_roulette { FLAG_RUSSIAN_ROULETTE } else { 0 },
-            emitter_count: scene.emitters.len() as u32,
+            emitter_count: scene.emitter_count,
             ..Default::default()
         };
         scene.cameras[self.camera].fill_params(&mut params, self.width, self.height);

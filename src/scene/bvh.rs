@@ -279,7 +279,7 @@ pub const SEGMENT_EPSILON: f32 = 1e-4;
 
 /// Whether anything blocks the segment between surface points p (normal np, on triangle index
 /// tp) and q (normal nq, on triangle index tq): the ray of `segment_ray`, traced (the kernels
-/// trace it inside `visibility_ray` of glsl/shift.glsl). Both ends are offset off their
+/// trace it inside `visibility_ray` of glsl/shift_vertex.glsl). Both ends are offset off their
 /// surfaces, each towards the other: offsetting one end only moves a grazing far hit by more
 /// than any epsilon.
 #[allow(clippy::too_many_arguments)]

@@ -87,6 +87,9 @@ fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<GltfChunks<'a>> {
     Ok((Cow::Owned(glb.json.into_owned()), glb.bin.map(|b| b.into_owned())))
 }
 
+/// The first non-blank byte of JSON text: an object's or an array's opening bracket (RFC 8259).
+const JSON_TEXT_START: [u8; 2] = [b'{', b'['];
+
 /// Reads the JSON and applies the checks and removals described in the module comment;
 /// `warn` receives each warning (without the file name).
 pub(super) fn read_raw(bytes: &[u8], path: &Path, warn: &mut dyn FnMut(String)) -> Result<RawGltf> {
@@ -96,7 +99,7 @@ pub(super) fn read_raw(bytes: &[u8], path: &Path, warn: &mut dyn FnMut(String)) 
         // kind of file (an image, an OBJ, a Blender file), which a parser's position says little about.
         let first = json_bytes.iter().find(|b| !b.is_ascii_whitespace());
         match first {
-            Some(b'{' | b'[') => problem(path, format!("invalid glTF: {e}")),
+            Some(b) if JSON_TEXT_START.contains(b) => problem(path, format!("invalid glTF: {e}")),
             None => problem(path, "the file is empty, not a glTF file"),
             Some(_) => problem(
                 path,

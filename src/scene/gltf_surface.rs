@@ -111,7 +111,7 @@ impl Loader<'_> {
 
     /// The attributes of triangle `k` of a primitive (vertex indices `tri`, corners in the
     /// order the triangle is stored), and whether its vertex normals differ from its face
-    /// normal `face`.
+    /// normal `face` (where none does, by 1 - cos within `FLAT_TOLERANCE`, they are left out).
     pub(super) fn triangle_surface(
         surface: &PrimitiveSurface,
         k: usize,
@@ -135,6 +135,11 @@ impl Loader<'_> {
             let uv0 = surface.uv[0].as_ref().map_or(Vec2::ZERO, |u| u[v]);
             let uv1 = surface.uv[1].as_ref().map_or(Vec2::ZERO, |u| u[v]);
             out.uv[slot] = [uv0.x, uv0.y, uv1.x, uv1.y];
+        }
+        // Flat vertex normals are stored as none: the face normal is used, exactly, and a scene
+        // with no others compiles without shading normals (Scene::has_shading_normals).
+        if !smooth {
+            out.normal = TriangleSurface::flat().normal;
         }
         (out, smooth)
     }
@@ -174,8 +179,11 @@ impl mikktspace::Geometry for MikkInput<'_> {
         self.uv[self.tris[face][vert] as usize].to_array()
     }
     fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
-        // MikkTSpace's bitangent sign convention is glTF's (the reference implementation's).
-        self.out[face][vert] = Vec4::from(tangent);
+        // MikkTSpace's bitangent w · cross(n, t) points along +v of the coordinates it was given,
+        // but glTF's v runs down the image while a normal texture's +Y (green) points up it
+        // (glTF 2.0 section 3.9.3): the sign is negated, as three.js (computeMikkTSpaceTangents'
+        // negateSign, "required for glTF") and Bevy do.
+        self.out[face][vert] = Vec4::new(tangent[0], tangent[1], tangent[2], -tangent[3]);
     }
 }
 

@@ -89,67 +89,7 @@ impl Loader<'_> {
         let mut headers: HashMap<usize, u32> = HashMap::new();
         let mut per_material = Vec::new();
         for m in doc.materials() {
-            let pbr = m.pbr_metallic_roughness();
-            let mut t = MaterialTextures {
-                normal_scale: 1.0,
-                alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
-                alpha_mode: match m.alpha_mode() {
-                    gltf::material::AlphaMode::Opaque => ALPHA_OPAQUE,
-                    gltf::material::AlphaMode::Mask => ALPHA_MASK,
-                    gltf::material::AlphaMode::Blend => ALPHA_BLEND,
-                },
-                base_alpha: pbr.base_color_factor()[3].clamp(0.0, 1.0),
-                ..Default::default()
-            };
-            let mut refs = [
-                slot_ref(pbr.base_color_texture()),
-                slot_ref(pbr.metallic_roughness_texture()),
-                slot_ref(m.emissive_texture()),
-                None,
-            ];
-            let mut normal_xf = None;
-            if let Some((r, scale)) = normal_ref(&m) {
-                refs[3] = Some(r);
-                t.normal_scale = scale;
-                normal_xf = normal_transform(&m);
-            }
-            for (k, r) in refs.iter().enumerate() {
-                let Some(r) = r else { continue };
-                let header = match headers.get(&r.texture.index()) {
-                    Some(&h) => h,
-                    None => {
-                        let h = self.add_texture(&r.texture, &mut out)?;
-                        headers.insert(r.texture.index(), h);
-                        h
-                    }
-                };
-                let (offset, rotation, scale, tex_coord) = match (&r.transform, k == 3) {
-                    (Some(x), _) => (x.offset(), x.rotation(), x.scale(), x.tex_coord()),
-                    (None, true) => normal_xf.unwrap_or(([0.0; 2], 0.0, [1.0; 2], None)),
-                    (None, false) => ([0.0; 2], 0.0, [1.0; 2], None),
-                };
-                let set = tex_coord.unwrap_or(r.tex_coord);
-                if set > 1 {
-                    self.warn(format!(
-                        "texture {} uses TEXCOORD_{set}; only sets 0 and 1 are read, 0 used",
-                        r.texture.index()
-                    ));
-                }
-                let (u_row, v_row) = texture_transform_rows(offset, rotation, scale);
-                let slot = TextureSlot {
-                    u_row,
-                    texture_index: header,
-                    v_row,
-                    texcoord: if set == 1 { 1 } else { 0 },
-                };
-                match k {
-                    0 => t.base_color = slot,
-                    1 => t.metal_rough = slot,
-                    2 => t.emissive = slot,
-                    _ => t.normal = slot,
-                }
-            }
-            per_material.push(t);
+            per_material.push(self.material_textures(&m, &mut headers, &mut out)?);
         }
         out.materials = material_sources
             .iter()
@@ -170,6 +110,84 @@ impl Loader<'_> {
             ));
         }
         Ok(out)
+    }
+
+    /// The texture slots and alpha state of material `m`; images not yet in `headers` (glTF
+    /// texture index to header index) are decoded into `out`.
+    fn material_textures(
+        &mut self,
+        m: &gltf::Material,
+        headers: &mut HashMap<usize, u32>,
+        out: &mut SceneTextures,
+    ) -> Result<MaterialTextures> {
+        let pbr = m.pbr_metallic_roughness();
+        let mut t = MaterialTextures {
+            normal_scale: 1.0,
+            alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
+            alpha_mode: match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => ALPHA_OPAQUE,
+                gltf::material::AlphaMode::Mask => ALPHA_MASK,
+                gltf::material::AlphaMode::Blend => ALPHA_BLEND,
+            },
+            base_alpha: pbr.base_color_factor()[3].clamp(0.0, 1.0),
+            ..Default::default()
+        };
+        let mut refs = [
+            slot_ref(pbr.base_color_texture()),
+            slot_ref(pbr.metallic_roughness_texture()),
+            slot_ref(m.emissive_texture()),
+            None,
+        ];
+        let mut normal_xf = None;
+        if let Some((r, scale)) = normal_ref(m) {
+            refs[3] = Some(r);
+            t.normal_scale = scale;
+            normal_xf = normal_transform(m);
+        }
+        for (k, r) in refs.iter().enumerate() {
+            let Some(r) = r else { continue };
+            let header = match headers.get(&r.texture.index()) {
+                Some(&h) => h,
+                None => {
+                    let h = self.add_texture(&r.texture, out)?;
+                    headers.insert(r.texture.index(), h);
+                    h
+                }
+            };
+            // The normal texture's transform comes from the extension gltf does not expose.
+            let fallback = if k == 3 { normal_xf } else { None };
+            let slot = self.texture_slot(r, header, fallback);
+            match k {
+                0 => t.base_color = slot,
+                1 => t.metal_rough = slot,
+                2 => t.emissive = slot,
+                _ => t.normal = slot,
+            }
+        }
+        Ok(t)
+    }
+
+    /// The slot of texture reference `r` whose image is header `header`; `fallback` is the
+    /// transform used when `r` carries none.
+    fn texture_slot(&mut self, r: &SlotRef, header: u32, fallback: Option<UvTransform>) -> TextureSlot {
+        let (offset, rotation, scale, tex_coord) = match &r.transform {
+            Some(x) => (x.offset(), x.rotation(), x.scale(), x.tex_coord()),
+            None => fallback.unwrap_or(([0.0; 2], 0.0, [1.0; 2], None)),
+        };
+        let set = tex_coord.unwrap_or(r.tex_coord);
+        if set > 1 {
+            self.warn(format!(
+                "texture {} uses TEXCOORD_{set}; only sets 0 and 1 are read, 0 used",
+                r.texture.index()
+            ));
+        }
+        let (u_row, v_row) = texture_transform_rows(offset, rotation, scale);
+        TextureSlot {
+            u_row,
+            texture_index: header,
+            v_row,
+            texcoord: if set == 1 { 1 } else { 0 },
+        }
     }
 
     /// Decodes the image of `texture` into `out` with its sampler; returns its header's index.

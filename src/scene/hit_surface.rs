@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use super::Scene;
 use crate::gpu_types::Material;
 use crate::shading::surface::{surface_at, SurfaceHit, TriangleSurface};
-use crate::shading::texture::{normal_mapped, textured_material};
+use crate::shading::texture::{normal_mapped, textured_material, NO_TEXTURE};
 
 impl Scene {
     /// The surface of triangle `triangle` at barycentrics `bary` (flat where the scene has no
@@ -28,8 +28,9 @@ impl Scene {
         textured_material(m, &self.textures.materials[index], &self.textures, &self.surface_at(triangle, bary))
     }
 
-    /// The shading normal of triangle `triangle` at `bary`: the interpolated vertex normal with
-    /// its material's normal map applied.
+    /// The shading normal of triangle `triangle` at `bary` (unit, scene space, not flipped): the
+    /// interpolated vertex normal with its material's normal map applied; the geometric normal
+    /// as wound where there are neither. Twin of GLSL `shading_normal` (glsl/shading_frame.glsl).
     pub fn shading_normal(&self, triangle: u32, bary: Vec2) -> Vec3 {
         let s = self.surface_at(triangle, bary);
         if self.textures.is_empty() || self.surfaces.is_empty() {
@@ -37,6 +38,31 @@ impl Scene {
         }
         let index = self.triangles[triangle as usize].material as usize;
         normal_mapped(&self.textures.materials[index], &self.textures, &s)
+    }
+
+    /// The material (textures applied) and the shading normal of triangle `triangle` at `bary`,
+    /// from one surface: what the path tracer hands the BSDF with the geometric normal. Twin of
+    /// GLSL `hit_shading` (glsl/shading_frame.glsl).
+    pub fn hit_shading(&self, triangle: u32, bary: Vec2) -> (Material, Vec3) {
+        let index = self.triangles[triangle as usize].material as usize;
+        let m = &self.materials[index];
+        let s = self.surface_at(triangle, bary);
+        if self.textures.is_empty() || self.surfaces.is_empty() {
+            return (*m, s.normal);
+        }
+        let t = &self.textures.materials[index];
+        (textured_material(m, t, &self.textures, &s), normal_mapped(t, &self.textures, &s))
+    }
+
+    /// Whether any shading normal can differ from the geometric normal: some triangle has vertex
+    /// normals, or some material a normal map. Without, kernels compile without the shading frame
+    /// (`SCENE_SHADING_NORMALS 0`) and shade with the geometric normal.
+    pub fn has_shading_normals(&self) -> bool {
+        if self.surfaces.is_empty() {
+            return false;
+        }
+        let normal_map = !self.textures.is_empty() && self.textures.materials.iter().any(|t| t.normal.texture_index != NO_TEXTURE);
+        normal_map || self.surfaces.iter().any(|s| s.normal.iter().any(|n| n[..3] != [0.0; 3]))
     }
 
     /// One line on the vertex attributes and textures and the device memory they take, or

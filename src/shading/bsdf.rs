@@ -261,6 +261,32 @@ pub fn bsdf_sample(m: &Material, ng: Vec3, ns: Vec3, wo_world: Vec3, u: Vec4) ->
     s
 }
 
+/// The smooth dielectric's delta sample from local `wo` in `frame` (tangent, bitangent,
+/// normal): reflection when `u` < the Fresnel reflectance, else refraction; `w_t` is the lobe's
+/// weight. Twin of GLSL `sample_smooth_dielectric`.
+pub fn sample_smooth_dielectric(m: &Material, wo: Vec3, w_t: f32, u: f32, frame: (Vec3, Vec3, Vec3)) -> BsdfSample {
+    let (t, b, n) = frame;
+    let base = Vec3::from(m.base_color);
+    let fr = fresnel_dielectric(wo.z, m.ior);
+    if u < fr {
+        return BsdfSample {
+            wi: to_world(Vec3::new(-wo.x, -wo.y, wo.z), t, b, n),
+            weight: base,
+            pdf: w_t * fr,
+            lobe: LOBE_DIELECTRIC | LOBE_DELTA,
+        };
+    }
+    let Some((wt, etap)) = refract_dir(wo, Vec3::Z, m.ior) else {
+        return BsdfSample::FAILED;
+    };
+    BsdfSample {
+        wi: to_world(wt, t, b, n),
+        weight: base / (etap * etap),
+        pdf: w_t * (1.0 - fr),
+        lobe: LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION,
+    }
+}
+
 /// [`bsdf_sample`] in the frame of normal `n` alone (no side checks). Twin of GLSL
 /// `bsdf_sample_frame`.
 pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
@@ -312,24 +338,7 @@ pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> Bsdf
             };
         }
         if alpha < DELTA_ALPHA {
-            let fr = fresnel_dielectric(wo.z, m.ior);
-            if u.w < fr {
-                return BsdfSample {
-                    wi: to_world(mirrored, t, b, n),
-                    weight: base,
-                    pdf: w_t * fr,
-                    lobe: LOBE_DIELECTRIC | LOBE_DELTA,
-                };
-            }
-            let Some((wt, etap)) = refract_dir(wo, Vec3::Z, m.ior) else {
-                return BsdfSample::FAILED;
-            };
-            return BsdfSample {
-                wi: to_world(wt, t, b, n),
-                weight: base / (etap * etap),
-                pdf: w_t * (1.0 - fr),
-                lobe: LOBE_DIELECTRIC | LOBE_DELTA | LOBE_TRANSMISSION,
-            };
+            return sample_smooth_dielectric(m, wo, w_t, u.w, (t, b, n));
         }
         let wm = sample_ggx_vndf(wo * side, alpha, u.truncate().truncate());
         let fr = fresnel_dielectric(wo.dot(wm), m.ior);

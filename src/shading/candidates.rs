@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 
+use crate::gpu_types::Material;
 use crate::scene::Scene;
 use crate::shading::bsdf::{bsdf_eval_pdf, LOBE_DELTA, LOBE_NONE};
 use crate::shading::gris::{resampler_offer, target_function, Resampler};
@@ -84,6 +85,33 @@ fn record_chosen(
     }
 }
 
+/// The NEE candidate at x_i (material `m`, leaving towards `wo`, after the prefix weight
+/// `prefix` of x1..x_{i-1}): the path x1..x_i plus the light vertex NEE chooses with the path's
+/// random numbers; `None` if it carries no light.
+fn nee_candidate(scene: &Scene, x: &Vertex, m: &Material, wo: Vec3, seed: u32, i: usize, prefix: Vec3) -> Option<TracedCandidate> {
+    let (ls, light) = nee_vertex(scene, x, seed, i)?;
+    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir);
+    if f_cos.max_element() <= 0.0 || !visible(scene, x, &light) {
+        return None;
+    }
+    let weight = f_cos / ls.pdf;
+    // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand.
+    let end_weight = if vertex_is_punctual(&light) {
+        1.0
+    } else {
+        balance_heuristic(ls.pdf, bsdf_pdf)
+    };
+    let contribution = prefix * weight * end_emission(scene, x, &light) * end_weight;
+    (contribution.max_element() > 0.0).then_some(TracedCandidate {
+        count: i + 1,
+        nee_end: true,
+        light,
+        nee_weight: weight,
+        end_weight,
+        contribution,
+    })
+}
+
 /// Streams every light-ending prefix of at most `max_length` vertices of the path from `y1`
 /// (seen from `camera`) with `seed`'s random numbers into `s`.
 #[allow(clippy::too_many_arguments)]
@@ -119,27 +147,9 @@ pub fn stream_path_candidates(
         let wo = (prev_pos - x.pos).normalize();
         let m = material_of(scene, &x);
         let u = rng_uniform4(seed, i as u32, STREAM_RESAMPLE);
-        if let Some((ls, light)) = nee_vertex(scene, &x, seed, i) {
-            let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&m, x.normal, x.normal, wo, ls.dir);
-            if f_cos.max_element() > 0.0 && visible(scene, &x, &light) {
-                let weight = f_cos / ls.pdf;
-                // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand.
-                let end_weight = if vertex_is_punctual(&light) {
-                    1.0
-                } else {
-                    balance_heuristic(ls.pdf, bsdf_pdf)
-                };
-                let contribution = prefix * weight * end_emission(scene, &x, &light) * end_weight;
-                if contribution.max_element() > 0.0 && offer_candidate(s, &mut counts, contribution, scale, u.x) {
-                    chosen = Some(TracedCandidate {
-                        count: i + 1,
-                        nee_end: true,
-                        light,
-                        nee_weight: weight,
-                        end_weight,
-                        contribution,
-                    });
-                }
+        if let Some(c) = nee_candidate(scene, &x, &m, wo, seed, i, prefix) {
+            if offer_candidate(s, &mut counts, c.contribution, scale, u.x) {
+                chosen = Some(c);
             }
         }
         let Some((b, next)) = bsdf_vertex(scene, &x, wo, &m, seed, i) else {

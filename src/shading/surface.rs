@@ -18,7 +18,8 @@ use crate::shading::sampling::build_onb;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct TriangleSurface {
-    /// xyz: the vertex normal (unit, or zero where the file gave none: the face normal is used);
+    /// xyz: the vertex normal (unit, or zero where the file gave none or the triangle is flat:
+    /// the face normal is used);
     /// w: unused.
     pub normal: [[f32; 4]; 3],
     /// xyz: the vertex tangent (along +u of the normal texture's coordinates); w: its handedness

@@ -1,15 +1,17 @@
 //! GLSL bvh.glsl, lights.glsl and camera.glsl against their Rust twins on a non-trivial scene:
 //! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3, Vec4};
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::bvh::{trace_closest, trace_occluded, NO_HIT};
 use restir_pt::scene::gltf_writer::MeshData;
 use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
-use restir_pt::shading::lights::sample_light;
+use restir_pt::shading::lights::{sample_light, LightSample};
 use restir_pt::shading::ray_offset::offset_ray_origin;
-use restir_pt::vk::{BindingSlot, Buffer, BufferUsage};
+use restir_pt::vk::{Buffer, BufferUsage, Context};
 
 use crate::common::{assert_clean, close, gpu, run_oracle_with_defines, TestRng};
 
@@ -144,24 +146,42 @@ fn bvh_traversal_lights_and_camera_glsl_matches_rust_addressed() {
     check_scene_oracle(&ctx, &scene, &scene_gpu, &[("SCENE_ADDRESSED", "1")]);
 }
 
-/// Runs oracle/scene_oracle.comp (compiled with `defines`) over random rays and compares every
-/// output with the Rust twins.
-fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene, scene_gpu: &SceneGpu, defines: &[(&str, &str)]) {
-    // Punctual lights share the alias table: light sampling's delta branch is compared too.
-    let settings = RenderSettings {
+/// The image size the oracle's camera rays and frame parameters use.
+fn oracle_settings() -> RenderSettings {
+    RenderSettings {
         width: 64,
         height: 48,
         ..Default::default()
-    };
+    }
+}
+
+/// The frame parameters of the uploaded `scene` at `settings`, on its device.
+fn params_buffer(scene: &SceneGpu, settings: &RenderSettings) -> Buffer {
     let params = Buffer::new(
-        ctx,
+        scene.ctx(),
         "params",
         std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[settings.frame_params(scene)]).unwrap();
+    params.write(&[settings.frame_params(scene.info())]).unwrap();
+    params
+}
 
+/// How many of check_scene_oracle's items reached the branches it must exercise.
+#[derive(Default)]
+struct Coverage {
+    hits: usize,
+    punctual_samples: usize,
+    punctual_shadowed: usize,
+}
+
+/// Runs oracle/scene_oracle.comp (compiled with `defines`) over random rays and compares every
+/// output with the Rust twins.
+fn check_scene_oracle(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, defines: &[(&str, &str)]) {
+    // Punctual lights share the alias table: light sampling's delta branch is compared too.
+    let settings = oracle_settings();
+    let params = params_buffer(scene_gpu, &settings);
     let mut r = TestRng(2);
     let mut inputs = Vec::with_capacity(4 * RAYS);
     for i in 0..RAYS {
@@ -182,62 +202,17 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         RAYS * 24,
         RAYS as u32,
     );
-
-    let camera = &scene.cameras[0];
-    let mut hits = 0;
-    let mut punctual_samples = 0;
-    let mut punctual_shadowed = 0;
+    let mut coverage = Coverage::default();
     for i in 0..RAYS {
-        let (o, d, u, px) = (
-            inputs[4 * i],
-            inputs[4 * i + 1].truncate(),
-            inputs[4 * i + 2].truncate(),
-            inputs[4 * i + 3],
-        );
-        let h = trace_closest(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
-        let g = &out[6 * i..6 * i + 6];
-        assert_eq!(
-            g[0].y.to_bits(),
-            h.triangle,
-            "trace_closest triangle, ray {i}: GLSL t {} vs Rust t {}",
-            g[0].x,
-            h.t
-        );
-        if h.triangle != NO_HIT {
-            hits += 1;
-            assert!(close(g[0].x, h.t, 1e-4), "trace_closest t, ray {i}");
-            assert!(
-                close(g[0].z, h.bary.x, 1e-4) && close(g[0].w, h.bary.y, 1e-4),
-                "trace_closest barycentrics, ray {i}"
-            );
-        }
-        let occluded = trace_occluded(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
-        assert_eq!(g[1].x == 1.0, occluded, "trace_occluded, ray {i}");
-        let off = offset_ray_origin(o.truncate(), d, &scene.triangles[i % scene.triangles.len()]);
-        for k in 0..3 {
-            assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
-        }
-        let ls = sample_light(scene, o.truncate(), u);
-        let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
-        assert!(
-            dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
-            "sample_light direction, item {i}"
-        );
-        assert!(
-            (g[3].truncate() - ls.radiance).abs().max_element() < 1e-4 && close(g[3].w, ls.pdf, 1e-3),
-            "sample_light value, item {i}"
-        );
-        let dir = camera.ray_dir(px.x, px.y, settings.width, settings.height);
-        assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
-        assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
-        if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
-            punctual_samples += 1;
-            let shadowed =
-                restir_pt::shading::lights::punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
-            assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
-            punctual_shadowed += shadowed as usize;
-        }
+        let (input, g) = (&inputs[4 * i..4 * i + 4], &out[6 * i..6 * i + 6]);
+        check_traversal(scene, input, g, i, &mut coverage);
+        check_light_and_camera(scene, &settings, input, g, i, &mut coverage);
     }
+    let Coverage {
+        hits,
+        punctual_samples,
+        punctual_shadowed,
+    } = coverage;
     assert!(
         punctual_samples > RAYS / 20,
         "only {punctual_samples} light samples chose a punctual light: the delta branch is not exercised"
@@ -251,6 +226,58 @@ fn check_scene_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scen
         "only {hits} of {RAYS} rays hit: the scene does not exercise traversal"
     );
     assert_clean(ctx);
+}
+
+/// trace_closest, trace_occluded and offset_ray_origin of ray `i` against their Rust twins.
+fn check_traversal(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
+    let (o, d) = (input[0], input[1].truncate());
+    let h = trace_closest(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
+    assert_eq!(
+        g[0].y.to_bits(),
+        h.triangle,
+        "trace_closest triangle, ray {i}: GLSL t {} vs Rust t {}",
+        g[0].x,
+        h.t
+    );
+    if h.triangle != NO_HIT {
+        coverage.hits += 1;
+        assert!(close(g[0].x, h.t, 1e-4), "trace_closest t, ray {i}");
+        assert!(
+            close(g[0].z, h.bary.x, 1e-4) && close(g[0].w, h.bary.y, 1e-4),
+            "trace_closest barycentrics, ray {i}"
+        );
+    }
+    let occluded = trace_occluded(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
+    assert_eq!(g[1].x == 1.0, occluded, "trace_occluded, ray {i}");
+    let off = offset_ray_origin(o.truncate(), d, &scene.triangles[i % scene.triangles.len()]);
+    for k in 0..3 {
+        assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
+    }
+}
+
+/// sample_light, camera_ray_dir and punctual_occluded of item `i` against their Rust twins.
+fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
+    let (o, d, u, px) = (input[0], input[1].truncate(), input[2].truncate(), input[3]);
+    let ls = sample_light(scene, o.truncate(), u);
+    let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
+    assert!(
+        dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
+        "sample_light direction, item {i}"
+    );
+    assert!(
+        (g[3].truncate() - ls.radiance).abs().max_element() < 1e-4 && close(g[3].w, ls.pdf, 1e-3),
+        "sample_light value, item {i}"
+    );
+    let dir = scene.cameras[0].ray_dir(px.x, px.y, settings.width, settings.height);
+    assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
+    assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
+    if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
+        coverage.punctual_samples += 1;
+        let shadowed =
+            restir_pt::shading::lights::punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+        assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
+        coverage.punctual_shadowed += shadowed as usize;
+    }
 }
 
 #[test]
@@ -296,24 +323,11 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
 /// with the scene's SCENE_ENV_MAP defines) against their Rust twins in src/shading/lights.rs.
 #[test]
 fn environment_map_light_sampling_glsl_matches_rust() {
-    use restir_pt::shading::lights::{environment_pdf, environment_radiance};
     let ctx = gpu();
     let scene = random_scene_full(5, vec![], Some(crate::sampling_statistics::test_environment_map()));
     assert!(scene.env_select_prob > 0.0 && scene.env_select_prob < 1.0);
-    let settings = RenderSettings {
-        width: 64,
-        height: 48,
-        ..Default::default()
-    };
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-    let params = Buffer::new(
-        &ctx,
-        "params",
-        std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
-        BufferUsage::Params,
-    )
-    .unwrap();
-    params.write(&[settings.frame_params(&scene)]).unwrap();
+    let params = params_buffer(&scene_gpu, &oracle_settings());
     let mut r = TestRng(6);
     let mut inputs = Vec::with_capacity(4 * RAYS);
     for _ in 0..RAYS {
@@ -322,21 +336,17 @@ fn environment_map_light_sampling_glsl_matches_rust() {
         inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
         inputs.push(Vec4::ZERO);
     }
-    let input = Buffer::from_slice(&ctx, "inputs", &inputs).unwrap();
-    let output = Buffer::new(&ctx, "outputs", (RAYS * 24 * 4) as u64, BufferUsage::Storage).unwrap();
-    output.fill(crate::common::NAN_FILL).unwrap();
-    let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend([
-        BindingSlot::storage(5, "Inputs").to(&input),
-        BindingSlot::storage(6, "Outputs").to(&output),
-    ]);
-    let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
     let defines = scene_gpu.defines();
     assert!(defines.contains(&("SCENE_ENV_MAP", "1")));
-    let kernel = restir_pt::vk::Kernel::new(&ctx, "oracle/scene_oracle.comp", &defines, &layout, 4).unwrap();
-    kernel.bind(&buffers).unwrap();
-    kernel.run_1d(RAYS as u32, 64, bytemuck::bytes_of(&(RAYS as u32))).unwrap();
-    let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(RAYS * 24).unwrap()).to_vec();
+    let out: Vec<Vec4> = run_oracle_with_defines(
+        &ctx,
+        "oracle/scene_oracle.comp",
+        &defines,
+        &scene_gpu.buffers(&params),
+        &[("Inputs", bytemuck::cast_slice(&inputs))],
+        RAYS * 24,
+        RAYS as u32,
+    );
     let (mut env_samples, mut near_edges) = (0, 0);
     for i in 0..RAYS {
         let (o, u) = (inputs[4 * i].truncate(), inputs[4 * i + 2].truncate());
@@ -351,26 +361,10 @@ fn environment_map_light_sampling_glsl_matches_rust() {
         );
         if ls.triangle == NO_EMITTER {
             env_samples += 1;
-            // The map is piecewise constant: radiance and pdf must agree unless the direction
-            // sits within 0.005 texels of a texel edge, where llvmpipe's atan/acos and Rust's
-            // may round to different texels.
-            let uv = restir_pt::scene::environment::equirect_uv(ls.dir) * Vec2::new(24.0, 12.0);
-            let edge = (uv - uv.round()).abs().min_element() < 5e-3;
-            if edge {
+            if !check_environment_sample(&scene, &ls, g[3], i) {
                 near_edges += 1;
                 continue;
             }
-            assert_eq!(
-                g[3].truncate(),
-                environment_radiance(&scene, ls.dir),
-                "environment radiance, item {i}"
-            );
-            assert!(
-                close(g[3].w, environment_pdf(&scene, ls.dir), 1e-4),
-                "environment pdf, item {i}: {} vs {}",
-                g[3].w,
-                ls.pdf
-            );
         }
         assert!(close(g[3].w, ls.pdf, 1e-3), "sample_light pdf, item {i}");
     }
@@ -379,6 +373,26 @@ fn environment_map_light_sampling_glsl_matches_rust() {
         near_edges * 50 < env_samples,
         "{near_edges} of {env_samples} samples on texel edges"
     );
-    drop(kernel);
     assert_clean(&ctx);
+}
+
+/// environment_radiance and environment_pdf of environment sample `i` (GLSL output `g3`)
+/// against their Rust twins; false (nothing compared) when the direction sits on a texel edge.
+fn check_environment_sample(scene: &Scene, ls: &LightSample, g3: Vec4, i: usize) -> bool {
+    use restir_pt::shading::lights::{environment_pdf, environment_radiance};
+    // The map is piecewise constant: radiance and pdf must agree unless the direction
+    // sits within 0.005 texels of a texel edge, where llvmpipe's atan/acos and Rust's
+    // may round to different texels.
+    let uv = restir_pt::scene::environment::equirect_uv(ls.dir) * Vec2::new(24.0, 12.0);
+    if (uv - uv.round()).abs().min_element() < 5e-3 {
+        return false;
+    }
+    assert_eq!(g3.truncate(), environment_radiance(scene, ls.dir), "environment radiance, item {i}");
+    assert!(
+        close(g3.w, environment_pdf(scene, ls.dir), 1e-4),
+        "environment pdf, item {i}: {} vs {}",
+        g3.w,
+        ls.pdf
+    );
+    true
 }

@@ -7,7 +7,7 @@
 use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::bvh::NO_HIT;
-use restir_pt::scene::load_scene;
+use restir_pt::scene::{load_scene, Scene};
 use restir_pt::shading::candidates::stream_path_candidates;
 use restir_pt::shading::gris::{resampler_begin, resampler_finish};
 use restir_pt::shading::path_record::{PathRecord, MAX_PATH_LENGTH};
@@ -65,48 +65,10 @@ fn stream_path_candidates_glsl_matches_rust() {
     for name in ["cornell", "cornell-glossy", "glass", "env-ground"] {
         let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
         let params = ShiftParams::for_scene(&scene);
-        let camera = scene.cameras[0].position;
-        let mut rng = TestRng(808);
-        let mut items: Vec<(Vertex, u32)> = Vec::with_capacity(ITEMS);
-        while items.len() < ITEMS {
-            let (px, py) = (rng.uniform() * IMAGE as f32, rng.uniform() * IMAGE as f32);
-            let seed = rng.next_u64() as u32;
-            if let Some(y1) = primary_hit(&scene, 0, px, py, IMAGE, IMAGE) {
-                items.push((y1, seed));
-            }
-        }
-        let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
-        let frame = Buffer::new(
-            &ctx,
-            "params",
-            std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
-            BufferUsage::Params,
-        )
-        .unwrap();
-        frame.write(&[RenderSettings::default().frame_params(&scene)]).unwrap();
+        let items = primary_hits(&scene);
         let scale = 0.5f32;
-        let kernel_params = [
-            MAX_PATH_LENGTH as u32,
-            params.roughness_threshold.to_bits(),
-            params.distance_threshold.to_bits(),
-            scale.to_bits(),
-        ];
-        let inputs: Vec<Vec4> = items
-            .iter()
-            .flat_map(|(y1, seed)| [y1.pos.extend(f32::from_bits(y1.triangle)), camera.extend(f32::from_bits(*seed))])
-            .collect();
-        let out: Vec<Vec4> = crate::common::run_oracle_with_defines(
-            &ctx,
-            "oracle/candidates_oracle.comp",
-            &scene_gpu.defines(),
-            &scene_gpu.buffers(&frame),
-            &[
-                ("Params", bytemuck::cast_slice(&kernel_params)),
-                ("Items", bytemuck::cast_slice(&inputs)),
-            ],
-            ITEMS * 8 * 4,
-            ITEMS as u32,
-        );
+        let out = run_candidates_oracle(&ctx, &scene, &items, &params, scale);
+        let camera = scene.cameras[0].position;
         let (mut chosen, mut differ, mut beyond_1e4, mut dropped) = (0, 0, 0, 0);
         for (i, (y1, seed)) in items.iter().enumerate() {
             let g = &out[8 * i..8 * i + 8];
@@ -150,4 +112,61 @@ fn stream_path_candidates_glsl_matches_rust() {
         assert!(chosen > ITEMS / 4, "{name}: only {chosen} items chose a path");
     }
     crate::common::assert_clean(&ctx);
+}
+
+/// ITEMS primary hits of camera 0 at random points of an IMAGE x IMAGE image, each with its
+/// own path seed (pixels that see nothing are drawn again).
+fn primary_hits(scene: &Scene) -> Vec<(Vertex, u32)> {
+    let mut rng = TestRng(808);
+    let mut items: Vec<(Vertex, u32)> = Vec::with_capacity(ITEMS);
+    while items.len() < ITEMS {
+        let (px, py) = (rng.uniform() * IMAGE as f32, rng.uniform() * IMAGE as f32);
+        let seed = rng.next_u64() as u32;
+        if let Some(y1) = primary_hit(scene, 0, px, py, IMAGE, IMAGE) {
+            items.push((y1, seed));
+        }
+    }
+    items
+}
+
+/// Runs oracle/candidates_oracle.comp over `items`: eight vec4s of results per item.
+fn run_candidates_oracle(
+    ctx: &std::sync::Arc<restir_pt::vk::Context>,
+    scene: &Scene,
+    items: &[(Vertex, u32)],
+    params: &ShiftParams,
+    scale: f32,
+) -> Vec<Vec4> {
+    let camera = scene.cameras[0].position;
+    let scene_gpu = SceneGpu::upload(ctx, scene).unwrap();
+    let frame = Buffer::new(
+        ctx,
+        "params",
+        std::mem::size_of::<restir_pt::gpu_types::FrameParams>() as u64,
+        BufferUsage::Params,
+    )
+    .unwrap();
+    frame.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
+    let kernel_params = [
+        MAX_PATH_LENGTH as u32,
+        params.roughness_threshold.to_bits(),
+        params.distance_threshold.to_bits(),
+        scale.to_bits(),
+    ];
+    let inputs: Vec<Vec4> = items
+        .iter()
+        .flat_map(|(y1, seed)| [y1.pos.extend(f32::from_bits(y1.triangle)), camera.extend(f32::from_bits(*seed))])
+        .collect();
+    crate::common::run_oracle_with_defines(
+        ctx,
+        "oracle/candidates_oracle.comp",
+        &scene_gpu.defines(),
+        &scene_gpu.buffers(&frame),
+        &[
+            ("Params", bytemuck::cast_slice(&kernel_params)),
+            ("Items", bytemuck::cast_slice(&inputs)),
+        ],
+        ITEMS * 8 * 4,
+        ITEMS as u32,
+    )
 }

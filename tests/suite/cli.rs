@@ -88,11 +88,14 @@ fn cli_info_describes_the_default_scene() {
     );
 }
 
+/// glTF JSON cut off inside its second object.
+const CUT_OFF_JSON: &[u8] = b"{ \"asset\": { \"version\": ";
+
 #[test]
 fn cli_bad_input_fails_with_one_clear_line() {
     let missing = "no/such/scene.gltf";
     assert_clean_failure(&["render", missing], &[missing, "cannot read"]);
-    let broken = temp_file("broken.gltf", b"{ \"asset\": { \"version\": ");
+    let broken = temp_file("broken.gltf", CUT_OFF_JSON);
     assert_clean_failure(&["render", broken.to_str().unwrap()], &["broken.gltf", "invalid glTF"]);
     let truncated = temp_file("truncated.glb", b"glTF\x02\x00\x00\x00\xff\x00\x00\x00");
     assert_clean_failure(&["info", truncated.to_str().unwrap()], &["truncated.glb"]);

@@ -186,7 +186,7 @@ fn glass_furnace_scene(ior: f32, sphere: bool) -> restir_pt::scene::Scene {
 /// neither has a non-finite pixel or weight.
 #[test]
 fn index_matched_rough_glass_is_invisible_to_both_renderers() {
-    use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings};
+    use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
     let ctx = gpu();
     let settings = RenderSettings {
         width: 32,
@@ -200,8 +200,8 @@ fn index_matched_rough_glass_is_invisible_to_both_renderers() {
     for ior in [1.0, 1.0 + 1e-6, 1.0 - 1e-6] {
         for sphere in [false, true] {
             let what = format!("IOR {ior}, {}", if sphere { "sphere" } else { "quad" });
-            let scene = glass_furnace_scene(ior, sphere);
-            let mut tracer = PathTracer::new(&ctx, &scene, &settings).unwrap();
+            let scene = SceneGpu::upload(&ctx, &glass_furnace_scene(ior, sphere)).unwrap();
+            let mut tracer = PathTracer::new(&scene, &settings).unwrap();
             let stats = tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
             let image = tracer.image().unwrap();
             drop(tracer);
@@ -215,10 +215,10 @@ fn index_matched_rough_glass_is_invisible_to_both_renderers() {
             if ior != 1.0 {
                 continue;
             }
-            let mut restir = Restir::new(&ctx, &scene, &settings, &RestirSettings::default()).unwrap();
+            let mut restir = Restir::new(&scene, &settings, &RestirSettings::default()).unwrap();
             let mut nonfinite = 0;
             for _ in 0..4 {
-                let c = restir.frame(&scene, 0, true).unwrap().counters;
+                let c = restir.frame(0, true).unwrap().counters;
                 nonfinite += c.nonfinite_weights + c.nonfinite_pixels;
             }
             let image = restir.image().unwrap();

@@ -5,7 +5,7 @@
 //! a chance of about 6%, and the per-pixel variance estimates are accurate to a few percent.
 //! Seeds are fixed, so the outcome is deterministic on a given driver.
 
-use restir_pt::render::{PathTracer, RenderSettings};
+use restir_pt::render::{PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::load_scene;
 
 use crate::common::{assert_clean, gpu, repo_path};
@@ -26,7 +26,7 @@ fn furnace(albedo: f32, russian_roulette: bool) {
         russian_roulette,
         camera: 0,
     };
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &settings).unwrap();
     let stats = tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
     assert_eq!(stats.spp, 1024);
     let image = tracer.image().unwrap();
@@ -81,7 +81,7 @@ fn over_long_dispatch_is_an_error_not_a_wrong_image() {
         spp: 2000,
         ..Default::default()
     };
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &settings).unwrap();
     let err = tracer
         .dispatch(2000)
         .expect_err("2000 samples in one dispatch exceed llvmpipe's loop budget");

@@ -230,7 +230,7 @@ fn every_kernel_declares_the_bindings_of_the_shader_interface() {
 /// layout, are refused.
 #[test]
 fn textured_scene_kernels_declare_the_surface_set() {
-    let textured = [("SCENE_SURFACE", "1"), ("SCENE_TEXTURES", "1")];
+    let textured = [("SCENE_SURFACE", "1"), ("SCENE_TEXTURES", "1"), ("SCENE_SHADING_NORMALS", "1")];
     let surface = || SurfaceBinding::ALL.iter().map(|b| b.slot(Binding::Storage));
     let expected: Vec<(u32, u32, String)> = SurfaceBinding::ALL
         .iter()

@@ -9,7 +9,7 @@
 //! which a wrong Jacobian, MIS weight or light pdf would miss.
 
 use glam::Vec3;
-use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ShiftKind};
+use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu, ShiftKind};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::scene::{load_scene, Scene};
 use restir_pt::shading::lights::spot_falloff;
@@ -144,7 +144,7 @@ fn settings(spp: u32) -> RenderSettings {
 
 fn path_traced(scene: &Scene, spp: u32) -> Image {
     let ctx = gpu();
-    let mut tracer = PathTracer::new(&ctx, scene, &settings(spp)).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, scene).unwrap(), &settings(spp)).unwrap();
     tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
     let image = tracer.image().unwrap();
     drop(tracer);
@@ -194,11 +194,11 @@ fn punctual_point_light_restir_matches_the_closed_form_irradiance() {
             shift,
             ..Default::default()
         };
-        let mut renderer = Restir::new(&ctx, &scene, &settings(1), &restir).unwrap();
+        let mut renderer = Restir::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &settings(1), &restir).unwrap();
         let mut attempted = 0;
         let mut failed = 0;
         for _ in 0..FRAMES {
-            let stats = renderer.frame(&scene, 0, true).unwrap();
+            let stats = renderer.frame(0, true).unwrap();
             attempted += stats.counters.shifts_attempted;
             failed += stats.counters.shifts_failed;
         }

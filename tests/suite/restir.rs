@@ -5,7 +5,7 @@
 use std::sync::atomic::AtomicBool;
 
 use restir_pt::metrics::{mse, rel_mse};
-use restir_pt::render::{PassKernel, PathTracer, RenderSettings, Restir, RestirSettings};
+use restir_pt::render::{PassKernel, PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
 use restir_pt::scene::{load_scene, Scene};
 
 use crate::common::{assert_clean, gpu, repo_path};
@@ -20,11 +20,11 @@ fn restir_same_seed_is_bit_identical() {
         height: 32,
         ..settings(1)
     };
-    let mut renderer = Restir::new(&ctx, &scene, &small, &RestirSettings::default()).unwrap();
+    let mut renderer = Restir::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &small, &RestirSettings::default()).unwrap();
     let mut chain = |seed: u32| -> Vec<u32> {
         renderer.reset(seed).unwrap();
         for camera in 0..FRAMES {
-            renderer.frame(&scene, camera, false).unwrap();
+            renderer.frame(camera, false).unwrap();
         }
         renderer
             .image()
@@ -48,7 +48,7 @@ fn restir_same_seed_is_bit_identical() {
 fn restir_compiles_every_kernel_at_start_up_and_none_in_frames() {
     let ctx = gpu();
     let (scene, small) = cornell_32_from_camera_0();
-    let mut renderer = Restir::new(&ctx, &scene, &small, &RestirSettings::default()).unwrap();
+    let mut renderer = Restir::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &small, &RestirSettings::default()).unwrap();
     let created = ctx.pipelines_created();
     assert_eq!(created, PassKernel::ALL.len() as u64);
     let reports = renderer.compile_reports();
@@ -60,15 +60,15 @@ fn restir_compiles_every_kernel_at_start_up_and_none_in_frames() {
         );
     }
     for camera in 0..4 {
-        renderer.frame(&scene, camera, false).unwrap();
+        renderer.frame(camera, false).unwrap();
     }
     for _ in 0..2 {
-        renderer.frame(&scene, 3, true).unwrap();
+        renderer.frame(3, true).unwrap();
     }
     renderer.set_reservoirs(2).unwrap();
     renderer.reset(3).unwrap();
     for camera in [0, 1, 1] {
-        renderer.frame(&scene, camera, false).unwrap();
+        renderer.frame(camera, false).unwrap();
     }
     assert_eq!(ctx.pipelines_created(), created, "a frame created a pipeline");
     assert_clean(&ctx);
@@ -95,15 +95,16 @@ fn cornell_32_from_camera_0() -> (Scene, RenderSettings) {
 fn restir_emission_rays_cut_light_edge_variance() {
     let ctx = gpu();
     let (scene, small) = cornell_32_from_camera_0();
+    let scene = SceneGpu::upload(&ctx, &scene).unwrap();
     let total_variance = |emission_rays: u32| -> f64 {
         let restir = RestirSettings {
             emission_rays,
             ..Default::default()
         };
-        let mut renderer = Restir::new(&ctx, &scene, &small, &restir).unwrap();
+        let mut renderer = Restir::new(&scene, &small, &restir).unwrap();
         renderer.reset(11).unwrap();
         for _ in 0..8 {
-            renderer.frame(&scene, 0, true).unwrap();
+            renderer.frame(0, true).unwrap();
         }
         renderer.image().unwrap().variance.iter().map(|v| luminance(*v)).sum()
     };
@@ -126,6 +127,7 @@ fn restir_emission_rays_cut_light_edge_variance() {
 fn restir_emission_running_mean_restarts_when_the_camera_moves() {
     let ctx = gpu();
     let (scene, small) = cornell_32_from_camera_0();
+    let scene = SceneGpu::upload(&ctx, &scene).unwrap();
     let emission_only = RenderSettings { max_depth: 1, ..small };
     let reference = |camera: usize| {
         let settings = RenderSettings {
@@ -133,7 +135,7 @@ fn restir_emission_running_mean_restarts_when_the_camera_moves() {
             camera,
             ..emission_only.clone()
         };
-        let mut pt = PathTracer::new(&ctx, &scene, &settings).unwrap();
+        let mut pt = PathTracer::new(&scene, &settings).unwrap();
         pt.render(&|_| {}, &AtomicBool::new(false)).unwrap();
         pt.image().unwrap().mean
     };
@@ -142,9 +144,9 @@ fn restir_emission_running_mean_restarts_when_the_camera_moves() {
         emission_rays: 1,
         ..Default::default()
     };
-    let mut renderer = Restir::new(&ctx, &scene, &emission_only, &restir).unwrap();
+    let mut renderer = Restir::new(&scene, &emission_only, &restir).unwrap();
     let frame = |renderer: &mut Restir, camera: usize| {
-        renderer.frame(&scene, camera, false).unwrap();
+        renderer.frame(camera, false).unwrap();
         renderer.image().unwrap().mean
     };
     const SEEDS: u32 = 8;
@@ -176,8 +178,7 @@ fn restir_emission_running_mean_restarts_when_the_camera_moves() {
 fn cornell_32_reference(ctx: &std::sync::Arc<restir_pt::vk::Context>) -> Vec<glam::Vec3> {
     let (scene, small) = cornell_32_from_camera_0();
     let mut pt = PathTracer::new(
-        ctx,
-        &scene,
+        &SceneGpu::upload(ctx, &scene).unwrap(),
         &RenderSettings {
             spp: 2048,
             ..small.clone()
@@ -198,18 +199,17 @@ fn cornell_32_temporal_only(ctx: &std::sync::Arc<restir_pt::vk::Context>, tempor
         emission_rays: 64,
         ..Default::default()
     };
-    Restir::new(ctx, &scene, &small, &restir).unwrap()
+    Restir::new(&SceneGpu::upload(ctx, &scene).unwrap(), &small, &restir).unwrap()
 }
 
 /// The relMSE of `renderer`'s frame 16 alone of a static camera, averaged over 4 seeds; asserts
 /// that no frame shifted a path.
 fn static_frame_16_rel_mse(renderer: &mut Restir, reference: &[glam::Vec3]) -> f64 {
-    let (scene, _) = cornell_32_from_camera_0();
     let mut errors = vec![];
     for seed in 0..4 {
         renderer.reset(21 + seed).unwrap();
         for _ in 0..16 {
-            let stats = renderer.frame(&scene, 0, false).unwrap();
+            let stats = renderer.frame(0, false).unwrap();
             assert_eq!(stats.counters.shifts_attempted, 0, "a static camera's temporal reuse shifted paths");
         }
         errors.push(rel_mse(&renderer.image().unwrap().mean, reference));

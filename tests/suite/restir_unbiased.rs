@@ -11,8 +11,8 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_pt::render::{History, Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, ShiftKind};
-use restir_pt::scene::{load_scene, Scene};
+use restir_pt::render::{History, Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind};
+use restir_pt::scene::load_scene;
 
 use crate::common::{assert_clean, gpu, repo_path};
 
@@ -59,20 +59,20 @@ fn blocks(image: &Image) -> Vec<(f64, f64)> {
     out.iter().map(|&(s, v)| (s / n, v / (n * n))).collect()
 }
 
-fn reference(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene) -> Image {
-    let mut pt = PathTracer::new(ctx, scene, &settings(REFERENCE_SPP)).unwrap();
+fn reference(scene: &std::sync::Arc<SceneGpu>) -> Image {
+    let mut pt = PathTracer::new(scene, &settings(REFERENCE_SPP)).unwrap();
     pt.render(&|_| {}, &AtomicBool::new(false)).unwrap();
     pt.image().unwrap()
 }
 
 /// One independent ReSTIR chain of FRAMES frames with `seed`, along cameras 0..FRAMES or, with
 /// `static_camera`, from the last of them throughout; the last frame's image.
-fn render_chain(renderer: &mut Restir, scene: &Scene, seed: u32, static_camera: bool) -> (Image, f64) {
+fn render_chain(renderer: &mut Restir, seed: u32, static_camera: bool) -> (Image, f64) {
     renderer.reset(seed).unwrap();
     let mut failed = 0.0;
     for frame in 0..FRAMES {
         let camera = if static_camera { FRAMES - 1 } else { frame };
-        let stats = renderer.frame(scene, camera, false).unwrap();
+        let stats = renderer.frame(camera, false).unwrap();
         assert_eq!(stats.counters.nonfinite_pixels, 0, "non-finite pixels");
         failed = stats.failed_shift_rate();
     }
@@ -175,13 +175,13 @@ fn check_unbiased(test: Unbiasedness) {
     };
     let ctx = gpu();
     let scene = load_scene(&repo_path(&format!("scenes/{}.gltf", test.scene))).unwrap();
-    let reference = blocks(&reference(&ctx, &scene));
+    let scene = SceneGpu::upload(&ctx, &scene).unwrap();
+    let reference = blocks(&reference(&scene));
     let mut max_failing = max_failing_blocks(reference.len());
     if test.path_tracer_control {
         let mut control = RenderSet::new(reference.len());
         for seed in 0..test.renders {
             let mut pt = PathTracer::new(
-                &ctx,
                 &scene,
                 &RenderSettings {
                     seed: 5000 + seed,
@@ -210,11 +210,11 @@ fn check_unbiased(test: Unbiasedness) {
             reservoirs: test.reservoirs,
             ..test.base.clone()
         };
-        let mut renderer = Restir::new(&ctx, &scene, &settings(1), &restir).unwrap();
+        let mut renderer = Restir::new(&scene, &settings(1), &restir).unwrap();
         let mut set = RenderSet::new(reference.len());
         let mut failed_rate = 0.0;
         for seed in 0..test.renders {
-            let (image, failed) = render_chain(&mut renderer, &scene, 1000 + seed, test.static_camera);
+            let (image, failed) = render_chain(&mut renderer, 1000 + seed, test.static_camera);
             failed_rate += failed / test.renders as f64;
             set.add(&image, &reference);
         }

@@ -4,7 +4,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use restir_pt::error::{vk_error, GpuError};
-use restir_pt::render::{PathTracer, RenderSettings};
+use restir_pt::render::{PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::{load_scene, load_scene_from_bytes};
 use restir_pt::vk::{Buffer, BufferUsage};
 
@@ -147,7 +147,7 @@ fn render_at(width: u32, height: u32) -> anyhow::Result<restir_pt::render::Image
         spp: 2,
         ..Default::default()
     };
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings)?;
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &scene)?, &settings)?;
     tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false))?;
     let image = tracer.image()?;
     drop(tracer);
@@ -207,8 +207,7 @@ fn robustness_no_vulkan_object_leaks_at_shutdown() {
     let log = ctx.validation_log();
     let scene = load_scene(&repo_path("scenes/cornell.gltf")).unwrap();
     let mut tracer = PathTracer::new(
-        &ctx,
-        &scene,
+        &SceneGpu::upload(&ctx, &scene).unwrap(),
         &RenderSettings {
             width: 16,
             height: 16,

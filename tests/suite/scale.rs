@@ -12,7 +12,6 @@ use std::sync::Arc;
 use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
 use restir_pt::scene::bundled_scenes::{cornell_sphere, tiled_floor, TILE_TRIANGLES};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
-use restir_pt::vk::Context;
 
 use crate::common::{assert_clean, gpu, gpu_with_scene_binding_limit};
 
@@ -36,16 +35,16 @@ fn sphere_scene() -> Scene {
     load_scene_from_bytes(cornell_sphere(20, 60).as_bytes(), None, Path::new("cornell-sphere.gltf")).unwrap()
 }
 
-fn path_traced(ctx: &Arc<Context>, scene: &Scene) -> Image {
-    let mut tracer = PathTracer::new(ctx, scene, &settings()).unwrap();
+fn path_traced(scene: &Arc<SceneGpu>) -> Image {
+    let mut tracer = PathTracer::new(scene, &settings()).unwrap();
     tracer.render(&|_| {}, &AtomicBool::new(false)).unwrap();
     tracer.image().unwrap()
 }
 
-fn restir_frames(ctx: &Arc<Context>, scene: &Scene) -> Image {
-    let mut restir = Restir::new(ctx, scene, &settings(), &RestirSettings::default()).unwrap();
+fn restir_frames(scene: &Arc<SceneGpu>) -> Image {
+    let mut restir = Restir::new(scene, &settings(), &RestirSettings::default()).unwrap();
     for _ in 0..2 {
-        restir.frame(scene, 0, true).unwrap();
+        restir.frame(0, true).unwrap();
     }
     restir.image().unwrap()
 }
@@ -69,17 +68,16 @@ fn scale_addressed_layout_renders_the_images_of_the_bound_layout() {
     let scene = sphere_scene();
     let bound_ctx = gpu();
     let addressed_ctx = gpu_with_scene_binding_limit(Some(TINY_LIMIT));
-    let layout = |ctx: &Arc<Context>| {
-        let g = SceneGpu::upload(ctx, &scene).unwrap();
-        (g.uniform, g.addressed())
-    };
-    assert_eq!(layout(&bound_ctx), (false, false), "the bound run must use storage buffers");
-    assert_eq!(layout(&addressed_ctx), (false, true), "the lowered limit must address the arrays");
-    let bound = path_traced(&bound_ctx, &scene);
-    let addressed = path_traced(&addressed_ctx, &scene);
+    let bound_scene = SceneGpu::upload(&bound_ctx, &scene).unwrap();
+    let addressed_scene = SceneGpu::upload(&addressed_ctx, &scene).unwrap();
+    let layout = |g: &SceneGpu| (g.uniform, g.addressed());
+    assert_eq!(layout(&bound_scene), (false, false), "the bound run must use storage buffers");
+    assert_eq!(layout(&addressed_scene), (false, true), "the lowered limit must address the arrays");
+    let bound = path_traced(&bound_scene);
+    let addressed = path_traced(&addressed_scene);
     assert_bit_identical("path tracer", &bound, &addressed);
-    let bound = restir_frames(&bound_ctx, &scene);
-    let addressed = restir_frames(&addressed_ctx, &scene);
+    let bound = restir_frames(&bound_scene);
+    let addressed = restir_frames(&addressed_scene);
     assert_bit_identical("ReSTIR PT", &bound, &addressed);
     assert_clean(&bound_ctx);
     assert_clean(&addressed_ctx);
@@ -104,7 +102,7 @@ fn scale_scene_past_one_binding_renders() {
         spp: 1,
         ..Default::default()
     };
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &settings).unwrap();
     let stats = tracer.render(&|_| {}, &AtomicBool::new(false)).unwrap();
     let image = tracer.image().unwrap();
     drop(tracer);

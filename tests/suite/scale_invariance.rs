@@ -5,7 +5,7 @@
 //! vertices lose nothing and any difference is the renderer's.
 
 use glam::{DVec3, Vec3};
-use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings};
+use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
 use serde_json::{json, Value};
@@ -86,7 +86,7 @@ const SETTINGS: RenderSettings = RenderSettings {
 };
 
 fn path_traced(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene) -> Image {
-    let mut tracer = PathTracer::new(ctx, scene, &SETTINGS).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(ctx, scene).unwrap(), &SETTINGS).unwrap();
     tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
     tracer.image().unwrap()
 }
@@ -94,9 +94,9 @@ fn path_traced(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene) -> I
 /// Eight accumulated ReSTIR PT frames (hybrid shifts, temporal and spatial reuse), so that every
 /// shift's visibility test and the regenerated paths see the moved scene.
 fn restir(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene) -> Image {
-    let mut renderer = Restir::new(ctx, scene, &SETTINGS, &RestirSettings::default()).unwrap();
+    let mut renderer = Restir::new(&SceneGpu::upload(ctx, scene).unwrap(), &SETTINGS, &RestirSettings::default()).unwrap();
     for _ in 0..8 {
-        renderer.frame(scene, 0, true).unwrap();
+        renderer.frame(0, true).unwrap();
     }
     renderer.image().unwrap()
 }

@@ -1,7 +1,7 @@
 //! The bundled scenes: committed files equal the generator's output, the README's table matches
 //! the loaded scenes, and every scene renders to a finite, non-black image.
 
-use restir_pt::render::{PathTracer, RenderSettings};
+use restir_pt::render::{PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::bundled_scenes::BUNDLED_SCENES;
 use restir_pt::scene::load_scene;
 
@@ -47,7 +47,7 @@ fn scenes_every_scene_renders_finite_and_non_black_at_64_spp() {
             spp: 64,
             ..Default::default()
         };
-        let mut tracer = PathTracer::new(&ctx, &loaded, &settings).unwrap();
+        let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &loaded).unwrap(), &settings).unwrap();
         tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
         let image = tracer.image().unwrap();
         assert_eq!(image.non_finite_count(), 0, "{}: non-finite pixels", scene.file_name);

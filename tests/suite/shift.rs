@@ -1,4 +1,4 @@
-//! The shift mappings' Rust reference (src/shading/shift.rs) on the bundled scenes: round trips,
+//! The shift mappings' Rust reference (src/shading/shift/) on the bundled scenes: round trips,
 //! reciprocal Jacobians, finite-difference Jacobians, injectivity and clean failure; the GLSL
 //! twins against it are in shift_oracle.rs.
 //! `cargo test --release shift` runs them all.

@@ -1,4 +1,4 @@
-//! GLSL glsl/shift.glsl against its Rust twins in src/shading/shift.rs: the forward shifts
+//! GLSL glsl/shift.glsl against its Rust twins in src/shading/shift/: the forward shifts
 //! (shift_reconnection, shift_random_replay, shift_hybrid) on base paths, and the inverse shifts
 //! (inverse_reconnection, inverse_random_replay, inverse_hybrid) on the paths the Rust forward
 //! shifts made, carried back to the base's primary hit, as the reuse passes' MIS weights use them.
@@ -78,7 +78,7 @@ fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, job
         BufferUsage::Params,
     )
     .unwrap();
-    frame.write(&[RenderSettings::default().frame_params(scene)]).unwrap();
+    frame.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
     let function = 3 * inverted as u32
         + match kind {
             Kind::Reconnection => 0,

@@ -245,7 +245,7 @@ fn specular_layer_roughness_changes_the_bsdf_and_the_image() {
 
 /// A white non-metal floor under a small bright quad light, seen at the light's mirror angle.
 fn render_highlight(ctx: &std::sync::Arc<restir_pt::vk::Context>, roughness: f32, specular: f32) -> restir_pt::render::Image {
-    use restir_pt::render::{PathTracer, RenderSettings};
+    use restir_pt::render::{PathTracer, RenderSettings, SceneGpu};
     use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
     let mut b = GltfBuilder::default();
     let floor = b.material(
@@ -280,7 +280,7 @@ fn render_highlight(ctx: &std::sync::Arc<restir_pt::vk::Context>, roughness: f32
         russian_roulette: false,
         camera: 0,
     };
-    let mut tracer = PathTracer::new(ctx, &scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(ctx, &scene).unwrap(), &settings).unwrap();
     tracer.render(&|_| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
     tracer.image().unwrap()
 }

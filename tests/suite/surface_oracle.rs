@@ -1,5 +1,6 @@
-//! GLSL surface.glsl and texture.glsl against src/surface.rs and src/texture.rs: surface_at,
-//! triangle_bary, texture_lookup, texture_coordinates, textured_material and normal_mapped on a
+//! GLSL surface.glsl, texture.glsl and shading_frame.glsl against src/surface.rs, src/texture.rs
+//! and src/scene/hit_surface.rs: surface_at, triangle_bary, texture_lookup, texture_coordinates,
+//! textured_material, normal_mapped, shading_normal and hit_shading (Scene methods) on a
 //! scene of random triangles with random vertex attributes and small random textures (every
 //! address mode, bilinear and nearest, sRGB and linear, KHR_texture_transform rows).
 
@@ -8,7 +9,7 @@ use restir_pt::gpu_types::{FrameParams, Material, Triangle, NO_EMITTER};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
 use restir_pt::shader_interface::SurfaceBinding;
-use restir_pt::shading::surface::{surface_at, triangle_bary, TriangleSurface};
+use restir_pt::shading::surface::{surface_at, triangle_bary, SurfaceHit, TriangleSurface};
 use restir_pt::shading::texture::{
     normal_mapped, texture_coordinates, texture_lookup, textured_material, MaterialTextures, SceneTextures, TextureHeader, TextureSlot,
     NO_TEXTURE, TEXTURE_NEAREST,
@@ -22,6 +23,8 @@ const TEXTURES: usize = 9;
 const MATERIALS: usize = 7;
 /// Relative agreement; sRGB decoding goes through llvmpipe's pow.
 const TOL: f32 = 2e-4;
+/// vec4 outputs per item (OUT_ROWS in surface_oracle.comp).
+const ROWS: usize = 10;
 
 fn random_textures(r: &mut TestRng) -> SceneTextures {
     let mut t = SceneTextures::default();
@@ -156,12 +159,26 @@ fn surface_oracle_on_the_avocado_sample() {
 /// Rust twin.
 fn compare_surfaces(scene: &Scene) {
     let ctx = gpu();
-    let textures = scene.textures.headers.len();
     let scene_gpu = SceneGpu::upload(&ctx, scene).unwrap();
-    let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
-    assert_eq!(surface.buffers.len(), 4, "attributes and three texture buffers");
-    let params = Buffer::new(&ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
-    params.write(&[FrameParams::default()]).unwrap();
+    let inputs = random_hits(scene);
+    let out = run_surface_oracle(&ctx, &scene_gpu, &inputs);
+    let (mut skipped, mut compared) = (0, 0);
+    for i in 0..ITEMS {
+        if check_item(scene, &inputs[3 * i..3 * i + 3], &out[ROWS * i..ROWS * i + ROWS], i) {
+            compared += 1;
+        } else {
+            skipped += 1;
+        }
+    }
+    assert!(skipped < ITEMS / 20, "{skipped} of {ITEMS} items near a nearest-filter texel edge");
+    assert!(compared > 0);
+    assert_clean(&ctx);
+}
+
+/// Three vec4s per item, as surface_oracle.comp reads them: (triangle bits, barycentrics,
+/// texture bits), (lookup uv, sRGB flag, 0), (hit point, 0).
+fn random_hits(scene: &Scene) -> Vec<Vec4> {
+    let textures = scene.textures.headers.len();
     let mut r = TestRng(11);
     let mut inputs: Vec<Vec4> = Vec::with_capacity(3 * ITEMS);
     for _ in 0..ITEMS {
@@ -179,8 +196,17 @@ fn compare_surfaces(scene: &Scene) {
         ));
         inputs.push(p.extend(0.0));
     }
-    let input = Buffer::from_slice(&ctx, "inputs", &inputs).unwrap();
-    let output = Buffer::new(&ctx, "outputs", (ITEMS * 8 * 16) as u64, BufferUsage::Storage).unwrap();
+    inputs
+}
+
+/// Dispatches surface_oracle.comp over `inputs`; `ROWS` vec4s of results per item.
+fn run_surface_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene_gpu: &SceneGpu, inputs: &[Vec4]) -> Vec<Vec4> {
+    let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
+    assert_eq!(surface.buffers.len(), 4, "attributes and three texture buffers");
+    let params = Buffer::new(ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
+    params.write(&[FrameParams::default()]).unwrap();
+    let input = Buffer::from_slice(ctx, "inputs", inputs).unwrap();
+    let output = Buffer::new(ctx, "outputs", (ITEMS * ROWS * 16) as u64, BufferUsage::Storage).unwrap();
     output.fill(NAN_FILL).unwrap();
     // The oracle binds everything in set 0: the surface family at 5-8 (SURFACE_SET 0,
     // SURFACE_BINDING 5 in surface_oracle.comp), then the inputs and outputs.
@@ -199,75 +225,97 @@ fn compare_surfaces(scene: &Scene) {
     let mut layout = scene_gpu.bindings();
     layout.extend(SurfaceBinding::ALL.iter().map(|&b| surface_slot(b)));
     layout.extend([BindingSlot::storage(9, "Inputs"), BindingSlot::storage(10, "Outputs")]);
-    let kernel = Kernel::new(&ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
+    let kernel = Kernel::new(ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
     kernel.bind(&buffers).unwrap();
     kernel.run_1d(ITEMS as u32, 64, bytemuck::bytes_of(&(ITEMS as u32))).unwrap();
-    let out: Vec<Vec4> = bytemuck::cast_slice(&output.read::<u32>(ITEMS * 32).unwrap()).to_vec();
-    let t = &scene.textures;
-    let (mut skipped, mut compared) = (0, 0);
-    for i in 0..ITEMS {
-        let (a, b) = (inputs[3 * i], inputs[3 * i + 1]);
-        let tri = a.x.to_bits();
-        let bary = Vec2::new(a.y, a.z);
-        let g = &out[8 * i..8 * i + 8];
-        let s = surface_at(&scene.triangles[tri as usize], &scene.surfaces[tri as usize], bary);
-        assert_vec3_close(format!("surface_at normal, item {i}"), g[0].truncate(), s.normal, TOL);
-        assert_eq!(g[0].w, s.handedness, "surface_at handedness, item {i}");
-        assert_vec3_close(format!("surface_at tangent, item {i}"), g[1].truncate(), s.tangent, TOL);
-        let uv = Vec4::new(s.uv0.x, s.uv0.y, s.uv1.x, s.uv1.y);
-        assert!((g[2] - uv).abs().max_element() < 1e-4, "surface_at uv, item {i}: {} vs {uv}", g[2]);
-        let bary_rust = triangle_bary(&scene.triangles[tri as usize], inputs[3 * i + 2].truncate());
-        assert!(
-            (g[7].truncate().truncate() - bary_rust).abs().max_element() < 1e-3,
-            "triangle_bary, item {i}"
-        );
-        assert!(
-            (bary_rust - bary).abs().max_element() < 1e-3,
-            "triangle_bary recovers the barycentrics, item {i}"
-        );
+    bytemuck::cast_slice(&output.read::<u32>(ITEMS * ROWS * 4).unwrap()).to_vec()
+}
 
-        let texture = a.w.to_bits();
-        let header = &t.headers[texture as usize];
-        let lookup_uv = Vec2::new(b.x, b.y);
-        let material = scene.triangles[tri as usize].material as usize;
-        let mt = &t.materials[material];
-        let slots = [mt.base_color, mt.metal_rough, mt.emissive, mt.normal];
-        let any_near_edge = near_texel_edge(header, lookup_uv)
-            || slots.iter().any(|sl| {
-                sl.texture_index != NO_TEXTURE && near_texel_edge(&t.headers[sl.texture_index as usize], texture_coordinates(sl, &s))
-            });
-        if any_near_edge {
-            skipped += 1;
-            continue;
-        }
-        compared += 1;
-        let c = texture_lookup(t, texture, lookup_uv, b.z > 0.5);
-        for k in 0..4 {
-            assert!(close(g[3][k], c[k], TOL), "texture_lookup, item {i}: GLSL {} vs Rust {c}", g[3]);
-        }
-        let coords = texture_coordinates(&mt.base_color, &s);
-        assert!(
-            (Vec2::new(g[7].z, g[7].w) - coords).abs().max_element() < 1e-4,
-            "texture_coordinates, item {i}"
-        );
-        let m = textured_material(&scene.materials[material], mt, t, &s);
-        assert_vec3_close(
-            format!("textured_material base colour, item {i}"),
-            g[4].truncate(),
-            m.base_color.into(),
-            TOL,
-        );
-        assert!(close(g[4].w, m.metallic, TOL), "textured_material metallic, item {i}");
-        assert_vec3_close(
-            format!("textured_material emission, item {i}"),
-            g[5].truncate(),
-            m.emission.into(),
-            TOL,
-        );
-        assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
-        assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, &s), 1e-3);
+/// Asserts item `i`'s GLSL outputs `g` against the Rust twins; false when the item was skipped
+/// because a nearest-filter lookup sits on a texel edge.
+fn check_item(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize) -> bool {
+    let (a, b) = (input[0], input[1]);
+    let tri = a.x.to_bits();
+    let bary = Vec2::new(a.y, a.z);
+    let s = surface_at(&scene.triangles[tri as usize], &scene.surfaces[tri as usize], bary);
+    assert_vec3_close(format!("surface_at normal, item {i}"), g[0].truncate(), s.normal, TOL);
+    assert_eq!(g[0].w, s.handedness, "surface_at handedness, item {i}");
+    assert_vec3_close(format!("surface_at tangent, item {i}"), g[1].truncate(), s.tangent, TOL);
+    let uv = Vec4::new(s.uv0.x, s.uv0.y, s.uv1.x, s.uv1.y);
+    assert!((g[2] - uv).abs().max_element() < 1e-4, "surface_at uv, item {i}: {} vs {uv}", g[2]);
+    let bary_rust = triangle_bary(&scene.triangles[tri as usize], input[2].truncate());
+    assert!(
+        (g[7].truncate().truncate() - bary_rust).abs().max_element() < 1e-3,
+        "triangle_bary, item {i}"
+    );
+    assert!(
+        (bary_rust - bary).abs().max_element() < 1e-3,
+        "triangle_bary recovers the barycentrics, item {i}"
+    );
+
+    let t = &scene.textures;
+    let texture = a.w.to_bits();
+    let header = &t.headers[texture as usize];
+    let lookup_uv = Vec2::new(b.x, b.y);
+    let material = scene.triangles[tri as usize].material as usize;
+    let mt = &t.materials[material];
+    let slots = [mt.base_color, mt.metal_rough, mt.emissive, mt.normal];
+    let any_near_edge = near_texel_edge(header, lookup_uv)
+        || slots.iter().any(|sl| {
+            sl.texture_index != NO_TEXTURE && near_texel_edge(&t.headers[sl.texture_index as usize], texture_coordinates(sl, &s))
+        });
+    if any_near_edge {
+        return false;
     }
-    assert!(skipped < ITEMS / 20, "{skipped} of {ITEMS} items near a nearest-filter texel edge");
-    assert!(compared > 0);
-    assert_clean(&ctx);
+    let c = texture_lookup(t, texture, lookup_uv, b.z > 0.5);
+    for k in 0..4 {
+        assert!(close(g[3][k], c[k], TOL), "texture_lookup, item {i}: GLSL {} vs Rust {c}", g[3]);
+    }
+    let coords = texture_coordinates(&mt.base_color, &s);
+    assert!(
+        (Vec2::new(g[7].z, g[7].w) - coords).abs().max_element() < 1e-4,
+        "texture_coordinates, item {i}"
+    );
+    check_textured_material(scene, material, &s, g, i);
+    check_shading_frame(scene, &g[8..10], tri, bary, i);
+    true
+}
+
+/// textured_material and normal_mapped of item `i` (outputs 4 to 6) against their Rust twins.
+fn check_textured_material(scene: &Scene, material: usize, s: &SurfaceHit, g: &[Vec4], i: usize) {
+    let (t, mt) = (&scene.textures, &scene.textures.materials[material]);
+    let m = textured_material(&scene.materials[material], mt, t, s);
+    assert_vec3_close(
+        format!("textured_material base colour, item {i}"),
+        g[4].truncate(),
+        m.base_color.into(),
+        TOL,
+    );
+    assert!(close(g[4].w, m.metallic, TOL), "textured_material metallic, item {i}");
+    assert_vec3_close(
+        format!("textured_material emission, item {i}"),
+        g[5].truncate(),
+        m.emission.into(),
+        TOL,
+    );
+    assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
+    assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, s), 1e-3);
+}
+
+/// GLSL `shading_normal` (row 0's xyz) and `hit_shading` (row 1's xyz the normal, the material's
+/// roughness and metallic in the rows' w) of item `i` against `Scene::shading_normal` and
+/// `Scene::hit_shading`.
+fn check_shading_frame(scene: &Scene, rows: &[Vec4], tri: u32, bary: Vec2, i: usize) {
+    let (m, ns) = scene.hit_shading(tri, bary);
+    assert_vec3_close(
+        format!("shading_normal, item {i}"),
+        rows[0].truncate(),
+        scene.shading_normal(tri, bary),
+        1e-3,
+    );
+    assert_vec3_close(format!("hit_shading normal, item {i}"), rows[1].truncate(), ns, 1e-3);
+    assert!(
+        close(rows[0].w, m.roughness, TOL) && close(rows[1].w, m.metallic, TOL),
+        "hit_shading material, item {i}"
+    );
 }

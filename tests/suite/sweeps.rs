@@ -102,10 +102,14 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
         1e-3,
         1e-7,
     );
+    assert_shard_alone_differs(&whole, &shards[0]);
+    check_merge_problems(&dir, &whole, &shards);
+}
 
-    // The shards' sums are disjoint shares: a shard alone is a different, 4-spp estimate.
-    let (_, _, one) = restir_pt::image_io::read_exr(&whole).unwrap();
-    let shard0 = restir_pt::app::read_shard(&shards[0]).unwrap();
+/// The shards' sums are disjoint shares: shard 0 of 3 alone is a different, 4-spp estimate.
+fn assert_shard_alone_differs(whole: &Path, shard: &Path) {
+    let (_, _, one) = restir_pt::image_io::read_exr(whole).unwrap();
+    let shard0 = restir_pt::app::read_shard(shard).unwrap();
     assert_eq!((shard0.meta.first_sample, shard0.meta.spp, shard0.sums[0][3]), (0, 4, 4.0));
     let differs = shard0
         .sums
@@ -117,7 +121,11 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
         differs > 100,
         "shard 0 alone should differ from the whole in most pixels: {differs} of 256"
     );
+}
 
+/// A missing shard warns; a shard twice, a shard of another seed, a plain EXR and a bad
+/// --shard fail with one clear line each and write nothing.
+fn check_merge_problems(dir: &Path, whole: &Path, shards: &[PathBuf]) {
     // Missing shard: a warning and the mean of the shards given.
     let (code, stdout, stderr) = restir_pt(&["merge", s(&shards[0]), s(&shards[2]), "--out", s(&dir.join("part.exr"))]);
     assert_eq!(code, 0, "{stderr}");
@@ -152,7 +160,7 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
         &["other.exr", "another reference"],
     );
     fails(
-        &["merge", s(&whole), "--out", s(&dir.join("x.exr"))],
+        &["merge", s(whole), "--out", s(&dir.join("x.exr"))],
         &["whole.exr", "not a reference shard"],
     );
     fails(
@@ -236,26 +244,7 @@ fn sweeps_compare_jobs_merge_into_the_one_process_results() {
         s(&reference),
     ]);
     let (one, split) = (dir.join("one"), dir.join("split"));
-    let args = |out: &Path| {
-        vec![
-            "compare".to_string(),
-            "scenes/cornell.gltf".into(),
-            "--reference".into(),
-            s(&reference).into(),
-            "--methods".into(),
-            "pt,restir:hybrid".into(),
-            "--budgets-ms".into(),
-            "0.001,1000000".into(),
-            "--frames".into(),
-            "2".into(),
-            "--trials".into(),
-            "2".into(),
-            "--max-depth".into(),
-            "3".into(),
-            "--out-dir".into(),
-            s(out).into(),
-        ]
-    };
+    let args = |out: &Path| compare_args(&reference, out);
     let one_args = args(&one);
     ok(&one_args.iter().map(String::as_str).collect::<Vec<_>>());
     let plan = split.join("jobs.jsonl");
@@ -266,7 +255,36 @@ fn sweeps_compare_jobs_merge_into_the_one_process_results() {
     assert!(!split.join("results.csv").exists(), "--plan runs nothing");
     let merged = run_plan(&plan, 4);
     assert!(merged.contains("4 jobs: wall"), "{merged}");
+    assert_same_compare_results(&one, &split);
+    check_job_reports(&split.join("jobs"), 4);
+    check_compare_sweep_problems(&split, &args(&split));
+}
 
+/// The arguments of the `compare` run the sweep test splits, writing into `out`.
+fn compare_args(reference: &Path, out: &Path) -> Vec<String> {
+    vec![
+        "compare".to_string(),
+        "scenes/cornell.gltf".into(),
+        "--reference".into(),
+        s(reference).into(),
+        "--methods".into(),
+        "pt,restir:hybrid".into(),
+        "--budgets-ms".into(),
+        "0.001,1000000".into(),
+        "--frames".into(),
+        "2".into(),
+        "--trials".into(),
+        "2".into(),
+        "--max-depth".into(),
+        "3".into(),
+        "--out-dir".into(),
+        s(out).into(),
+    ]
+}
+
+/// The merged results equal one process's in every column but the GPU time, with the
+/// charts, the image strip and the accounting of 4 jobs.
+fn assert_same_compare_results(one: &Path, split: &Path) {
     let (a, b) = (csv_rows(&one.join("results.csv")), csv_rows(&split.join("results.csv")));
     assert_eq!(a.len(), 1 + 3, "pt twice, ReSTIR PT once (skipped at 0.001 ms): {a:?}");
     assert_eq!(a.len(), b.len());
@@ -290,22 +308,24 @@ fn sweeps_compare_jobs_merge_into_the_one_process_results() {
     }
     let accounting = csv_rows(&split.join("accounting.csv"));
     assert_eq!(accounting.len(), 1 + 4, "{accounting:?}");
-    check_job_reports(&split.join("jobs"), 4);
+}
 
-    // A missing job, a job out of range, flags together, a plan without budgets.
+/// A missing job, a job out of range, flags together, a plan without budgets: one clear line
+/// each. `args` are the sweep's `compare` arguments writing into `split`.
+fn check_compare_sweep_problems(split: &Path, args: &[String]) {
     std::fs::remove_file(split.join("jobs/job_0002.csv")).unwrap();
-    let mut merge_args = args(&split);
+    let mut merge_args = args.to_vec();
     merge_args.extend(["--merge".into(), s(&split.join("jobs")).into()]);
     fails(
         &merge_args.iter().map(String::as_str).collect::<Vec<_>>(),
         &["job_0002.csv", "job 2"],
     );
-    let mut bad = args(&split);
+    let mut bad = args.to_vec();
     bad.extend(["--job".into(), "4".into()]);
     fails(&bad.iter().map(String::as_str).collect::<Vec<_>>(), &["--job 4", "4 jobs"]);
     bad.extend(["--plan".into(), "x.jsonl".into()]);
     fails(&bad.iter().map(String::as_str).collect::<Vec<_>>(), &["exclude each other"]);
-    let mut no_budgets = args(&split);
+    let mut no_budgets = args.to_vec();
     no_budgets.drain(6..8);
     no_budgets.extend(["--plan".into(), "x.jsonl".into()]);
     fails(&no_budgets.iter().map(String::as_str).collect::<Vec<_>>(), &["need --budgets-ms"]);

@@ -4,7 +4,7 @@
 use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
-use restir_pt::render::{PathTracer, RenderSettings};
+use restir_pt::render::{PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::bvh::{trace_closest, NO_HIT};
 use restir_pt::scene::gltf_writer::{textured_sphere, GltfBuilder, MaterialSpec, FILTER_LINEAR, WRAP_CLAMP_TO_EDGE, WRAP_REPEAT};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
@@ -88,7 +88,7 @@ fn textured_furnace_image_equals_the_albedo_as_seen() {
         russian_roulette: false,
         camera: 0,
     };
-    let mut tracer = PathTracer::new(&ctx, &scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, &scene).unwrap(), &settings).unwrap();
     tracer.render(&|_| {}, &AtomicBool::new(false)).unwrap();
     let image = tracer.image().unwrap();
     drop(tracer);

@@ -49,7 +49,7 @@ fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairR
         BufferUsage::Params,
     )
     .unwrap();
-    params.write(&[RenderSettings::default().frame_params(scene)]).unwrap();
+    params.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
     let inputs: Vec<Vec4> = pairs
         .iter()
         .flat_map(|(c, s)| {

@@ -1,6 +1,6 @@
 //! Textures, texture references and vertex attributes (NORMAL, TEXCOORD_n) for generated scenes.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use serde_json::{json, Value};
 
 use super::{GltfBuilder, MeshData};
@@ -72,6 +72,15 @@ impl GltfBuilder {
             self.meshes[mesh]["primitives"][0]["attributes"][format!("TEXCOORD_{set}")] = json!(accessor);
         }
         mesh
+    }
+
+    /// Gives mesh `mesh`'s first primitive a TANGENT attribute: xyz the tangent (along +u of the
+    /// normal texture's coordinates), w the handedness ±1 (bitangent = w · cross(normal, tangent)).
+    pub fn set_tangents(&mut self, mesh: usize, tangents: &[Vec4]) {
+        let floats: Vec<f32> = tangents.iter().flat_map(|t| t.to_array()).collect();
+        let view = self.push_view(bytemuck::cast_slice(&floats), 34962);
+        let accessor = self.push_accessor(json!({ "bufferView": view, "componentType": 5126, "count": tangents.len(), "type": "VEC4" }));
+        self.meshes[mesh]["primitives"][0]["attributes"]["TANGENT"] = json!(accessor);
     }
 }
 
