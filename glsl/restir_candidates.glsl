@@ -77,14 +77,15 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         Vertex x = path_vertex(i - 1u);
         if (vertex_is_escaped(x)) break;
         vec3 wo = normalize(prev_pos - x.pos);
-        Material m = material_of(x);
+        vec3 ns;
+        Material m = vertex_shading(x, ns);
         vec4 u = rng_uniform4(seed, i, STREAM_RESAMPLE);
 
         LightSample ls;
         Vertex light;
         if (nee_vertex(x, seed, i, ls, light)) {
             float bsdf_pdf;
-            vec3 f_cos = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir, bsdf_pdf);
+            vec3 f_cos = bsdf_eval_pdf(m, x.normal, ns, wo, ls.dir, bsdf_pdf);
             if (max_component(f_cos) > 0.0 && visible(x, light)) {
                 vec3 weight = f_cos / ls.pdf;
                 // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand (equal
@@ -100,7 +101,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
 
         BsdfSample b;
         Vertex next;
-        if (!bsdf_vertex(x, wo, m, seed, i, b, next)) break;
+        if (!bsdf_vertex(x, wo, m, ns, seed, i, b, next)) break;
         set_path_lobe(i - 1u, b.lobe);
         set_path_weight(i - 1u, b.weight);
         set_path_vertex(i, next);

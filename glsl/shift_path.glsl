@@ -68,10 +68,11 @@ bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex ligh
     return true;
 }
 
-// The BSDF sample at x_i drawn with the path's random numbers and the origin of its ray; false
-// if no lobe was sampled.
-bool bsdf_ray(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out vec3 origin) {
-    s = bsdf_sample(m, x.normal, x.normal, wo, rng_uniform4(seed, i, STREAM_BSDF));
+// The BSDF sample at x_i (material m, shading normal ns: vertex_shading) drawn with the path's
+// random numbers and the origin of its ray, offset along the geometric normal; false if no lobe
+// was sampled.
+bool bsdf_ray(Vertex x, vec3 wo, Material m, vec3 ns, uint seed, uint i, out BsdfSample s, out vec3 origin) {
+    s = bsdf_sample(m, x.normal, ns, wo, rng_uniform4(seed, i, STREAM_BSDF));
     if (s.lobe == LOBE_NONE) return false;
     origin = offset_ray_origin(x.pos, dot(s.wi, x.normal) > 0.0 ? x.normal : -x.normal, triangles[x.triangle]);
     return true;
@@ -84,9 +85,9 @@ Vertex ray_end_vertex(Hit hit, vec3 dir) {
 
 // The vertex BSDF sampling at x_i reaches with the path's random numbers; false if no lobe was
 // sampled. Initial candidates and path regeneration share it, so that both build the same paths.
-bool bsdf_vertex(Vertex x, vec3 wo, Material m, uint seed, uint i, out BsdfSample s, out Vertex next) {
+bool bsdf_vertex(Vertex x, vec3 wo, Material m, vec3 ns, uint seed, uint i, out BsdfSample s, out Vertex next) {
     vec3 origin;
-    if (!bsdf_ray(x, wo, m, seed, i, s, origin)) return false;
+    if (!bsdf_ray(x, wo, m, ns, seed, i, s, origin)) return false;
     next = ray_end_vertex(trace_closest(origin, s.wi, SHIFT_RAY_TMAX), s.wi);
     return true;
 }
@@ -117,7 +118,8 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
         Vertex x = path_vertex(i - 1u);
         if (vertex_is_escaped(x)) return false;
         vec3 wo = normalize(prev_pos - x.pos);
-        Material m = material_of(x);
+        vec3 ns;
+        Material m = vertex_shading(x, ns);
         bool nee_step = i + 1u == target_length && nee_end;
         Vertex next;
         uint lobe;
@@ -129,11 +131,11 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
             if (!nee_vertex(x, seed, i, ls, next)) return false;
             float bsdf_pdf;
             lobe = LOBE_NONE;
-            weight = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir, bsdf_pdf) / ls.pdf;
+            weight = bsdf_eval_pdf(m, x.normal, ns, wo, ls.dir, bsdf_pdf) / ls.pdf;
             visibility_ray(x, next, origin, dir, tmax);
         } else {
             BsdfSample s;
-            if (!bsdf_ray(x, wo, m, seed, i, s, origin)) return false;
+            if (!bsdf_ray(x, wo, m, ns, seed, i, s, origin)) return false;
             lobe = s.lobe;
             weight = s.weight;
             dir = s.wi;

@@ -18,8 +18,10 @@ Link reconnection_link(Vertex prev, vec3 before, Vertex x_r, bool nee_at_r) {
     Link link;
     float dist;
     direction(prev, x_r, link.dir, dist);
+    vec3 ns;
+    Material m = vertex_shading(prev, ns);
     float bsdf_pdf;
-    link.f_cos = bsdf_eval_pdf(material_of(prev), prev.normal, prev.normal, normalize(before - prev.pos), link.dir, bsdf_pdf);
+    link.f_cos = bsdf_eval_pdf(m, prev.normal, ns, normalize(before - prev.pos), link.dir, bsdf_pdf);
     link.pdf = nee_at_r ? light_pdf(prev, x_r) : bsdf_pdf;
     // A punctual x_r is one fixed point (or direction) whichever predecessor joins it: no
     // solid-angle-to-area factor, so its part of the Jacobian is 1.
@@ -31,8 +33,10 @@ float pdf_after(Vertex x_r, vec3 dir_in, Vertex next, bool next_is_nee, out vec3
     vec3 dir_next;
     float dist;
     direction(x_r, next, dir_next, dist);
+    vec3 ns;
+    Material m = vertex_shading(x_r, ns);
     float pdf;
-    f_cos = bsdf_eval_pdf(material_of(x_r), x_r.normal, x_r.normal, -dir_in, dir_next, pdf);
+    f_cos = bsdf_eval_pdf(m, x_r.normal, ns, -dir_in, dir_next, pdf);
     return next_is_nee ? light_pdf(x_r, next) : pdf;
 }
 

@@ -8,6 +8,7 @@
 #include "bvh.glsl"
 #include "lights.glsl"
 #include "punctual.glsl"
+#include "shading_frame.glsl"
 
 const float SHIFT_RAY_TMAX = 1e30;
 
@@ -21,7 +22,7 @@ struct ShiftParams {
 // direction towards it.
 struct Vertex {
     vec3 pos;
-    vec3 normal;
+    vec3 normal;      // the geometric normal (as wound); vertex_shading gives the shading normal
     uint triangle;
 };
 
@@ -51,6 +52,18 @@ Vertex vertex_on_surface(uint triangle, vec3 pos) {
 Vertex vertex_escaped(vec3 dir) { return Vertex(dir, vec3(0.0), NO_HIT); }
 
 Material material_of(Vertex v) { return material_at(v.triangle, triangle_bary(triangles[v.triangle], v.pos)); }
+
+// The material at surface vertex v and its shading normal ns: the path tracer's hit_shading
+// (the interpolated vertex normal with the material's normal map applied; v.normal in a scene
+// without shading normals). BSDFs evaluate in the frame of ns, as the path tracer's do, so that
+// candidates, shifts and the path tracer share one target function; v.normal, the geometric
+// normal, keeps deciding sides, ray offsets and the measure (docs/shift-mappings.md, "Shading
+// frame").
+Material vertex_shading(Vertex v, out vec3 ns) {
+    Material m;
+    hit_shading(v.triangle, triangle_bary(triangles[v.triangle], v.pos), v.normal, m, ns);
+    return m;
+}
 
 bool vertex_is_rough(Vertex v, ShiftParams params) {
     if (vertex_is_escaped(v) || vertex_is_punctual(v)) return true;
@@ -139,8 +152,10 @@ float end_mis_weight(Vertex x, vec3 before, Vertex end, bool nee_end, bool after
     vec3 dir;
     float dist;
     direction(x, end, dir, dist);
+    vec3 ns;
+    Material m = vertex_shading(x, ns);
     float bsdf_pdf;
-    bsdf_eval_pdf(material_of(x), x.normal, x.normal, normalize(before - x.pos), dir, bsdf_pdf);
+    bsdf_eval_pdf(m, x.normal, ns, normalize(before - x.pos), dir, bsdf_pdf);
     float light = light_pdf(x, end);
     return nee_end ? balance_heuristic(light, bsdf_pdf) : balance_heuristic(bsdf_pdf, light);
 }

@@ -13,8 +13,8 @@ use crate::shading::path_record::PathRecord;
 use crate::shading::rng::{rng_uniform4, STREAM_RESAMPLE};
 use crate::shading::sampling::balance_heuristic;
 use crate::shading::shift::{
-    bsdf_vertex, end_emission, end_mis_weight, material_of, nee_vertex, record_path, vertex_is_escaped, vertex_is_punctual, visible, Path,
-    ShiftParams, Vertex,
+    bsdf_vertex, end_emission, end_mis_weight, nee_vertex, record_path, vertex_is_escaped, vertex_is_punctual, vertex_shading, visible,
+    Path, ShiftParams, Vertex,
 };
 
 /// What the kernels count while streaming candidates (the pass statistics).
@@ -85,12 +85,22 @@ fn record_chosen(
     }
 }
 
-/// The NEE candidate at x_i (material `m`, leaving towards `wo`, after the prefix weight
+/// The NEE candidate at x_i (material `m` and shading normal `ns`, leaving towards `wo`, after the prefix weight
 /// `prefix` of x1..x_{i-1}): the path x1..x_i plus the light vertex NEE chooses with the path's
 /// random numbers; `None` if it carries no light.
-fn nee_candidate(scene: &Scene, x: &Vertex, m: &Material, wo: Vec3, seed: u32, i: usize, prefix: Vec3) -> Option<TracedCandidate> {
+#[allow(clippy::too_many_arguments)]
+fn nee_candidate(
+    scene: &Scene,
+    x: &Vertex,
+    m: &Material,
+    ns: Vec3,
+    wo: Vec3,
+    seed: u32,
+    i: usize,
+    prefix: Vec3,
+) -> Option<TracedCandidate> {
     let (ls, light) = nee_vertex(scene, x, seed, i)?;
-    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(m, x.normal, x.normal, wo, ls.dir);
+    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(m, x.normal, ns, wo, ls.dir);
     if f_cos.max_element() <= 0.0 || !visible(scene, x, &light) {
         return None;
     }
@@ -145,14 +155,14 @@ pub fn stream_path_candidates(
             break;
         }
         let wo = (prev_pos - x.pos).normalize();
-        let m = material_of(scene, &x);
+        let (m, ns) = vertex_shading(scene, &x);
         let u = rng_uniform4(seed, i as u32, STREAM_RESAMPLE);
-        if let Some(c) = nee_candidate(scene, &x, &m, wo, seed, i, prefix) {
+        if let Some(c) = nee_candidate(scene, &x, &m, ns, wo, seed, i, prefix) {
             if offer_candidate(s, &mut counts, c.contribution, scale, u.x) {
                 chosen = Some(c);
             }
         }
-        let Some((b, next)) = bsdf_vertex(scene, &x, wo, &m, seed, i) else {
+        let Some((b, next)) = bsdf_vertex(scene, &x, wo, &m, ns, seed, i) else {
             break;
         };
         p.lobes.push(b.lobe);

@@ -7,14 +7,15 @@
 use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::bvh::NO_HIT;
-use restir_pt::scene::{load_scene, Scene};
+use restir_pt::scene::Scene;
 use restir_pt::shading::candidates::stream_path_candidates;
 use restir_pt::shading::gris::{resampler_begin, resampler_finish};
 use restir_pt::shading::path_record::{PathRecord, MAX_PATH_LENGTH};
 use restir_pt::shading::shift::{primary_hit, ShiftParams, Vertex};
 use restir_pt::vk::{Buffer, BufferUsage};
 
-use crate::common::{repo_path, TestRng};
+use crate::common::TestRng;
+use crate::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
 
 const ITEMS: usize = 4096;
 const IMAGE: u32 = 64;
@@ -62,8 +63,8 @@ fn agrees(g: &[Vec4], record: &PathRecord, weight_sum: f32, w: f32, lost: bool, 
 #[test]
 fn stream_path_candidates_glsl_matches_rust() {
     let ctx = crate::common::gpu();
-    for name in ["cornell", "cornell-glossy", "glass", "env-ground"] {
-        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    for name in ["cornell", "cornell-glossy", "glass", "env-ground", NORMAL_MAPPED_BOX] {
+        let scene = scene_named(name);
         let params = ShiftParams::for_scene(&scene);
         let items = primary_hits(&scene);
         let scale = 0.5f32;
@@ -157,11 +158,12 @@ fn run_candidates_oracle(
         .iter()
         .flat_map(|(y1, seed)| [y1.pos.extend(f32::from_bits(y1.triangle)), camera.extend(f32::from_bits(*seed))])
         .collect();
-    crate::common::run_oracle_with_defines(
+    crate::common::run_scene_oracle(
         ctx,
+        &scene_gpu,
+        &frame,
         "oracle/candidates_oracle.comp",
-        &scene_gpu.defines(),
-        &scene_gpu.buffers(&frame),
+        &[],
         &[
             ("Params", bytemuck::cast_slice(&kernel_params)),
             ("Items", bytemuck::cast_slice(&inputs)),

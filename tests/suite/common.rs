@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use restir_pt::render::SceneGpu;
 use restir_pt::vk::{BindingSlot, BoundBuffer, Buffer, Context, ContextOptions, Kernel};
 
 /// NaN bits pre-filled into every output buffer, so that an unwritten slot fails a comparison.
@@ -35,15 +36,6 @@ pub fn repo_path(relative: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
 }
 
-/// The scene's bindings as storage buffers, as oracle kernels compiled without the scene's
-/// defines (SCENE_UNIFORM_BUFFERS unset) declare them.
-pub fn as_storage(bound: Vec<BoundBuffer>) -> Vec<BoundBuffer> {
-    bound
-        .into_iter()
-        .map(|b| BindingSlot::storage(b.slot.binding, b.slot.block).to(b.buffer))
-        .collect()
-}
-
 /// Runs an oracle kernel over `count` items. The `leading` buffers keep their bindings; the
 /// storage blocks named in `inputs` follow them in order, then the block `Outputs` of
 /// `output_words` 32-bit words pre-filled with NaN, which is returned. Kernel::new checks each
@@ -69,6 +61,40 @@ pub fn run_oracle_with_defines<T: bytemuck::Pod>(
     output_words: usize,
     count: u32,
 ) -> Vec<T> {
+    let build = |layout: &[BindingSlot]| Kernel::new(ctx, kernel, defines, layout, 4).unwrap();
+    run_built_oracle(ctx, build, leading, inputs, output_words, count)
+}
+
+/// `run_oracle` for a kernel that includes the scene bindings, compiled as the renderers compile
+/// theirs (`SceneGpu::defines`, then `defines`): set 0 holds the scene at 0-4 (`frame` its
+/// parameters), then the inputs and outputs; set 1 the surface attributes and textures of a
+/// scene that has them (`SceneGpu::kernel`).
+#[allow(clippy::too_many_arguments)]
+pub fn run_scene_oracle<T: bytemuck::Pod>(
+    ctx: &Arc<Context>,
+    scene_gpu: &SceneGpu,
+    frame: &Buffer,
+    kernel: &str,
+    defines: &[(&str, &str)],
+    inputs: &[(&'static str, &[u8])],
+    output_words: usize,
+    count: u32,
+) -> Vec<T> {
+    let mut all = scene_gpu.defines();
+    all.extend_from_slice(defines);
+    let build = |layout: &[BindingSlot]| scene_gpu.kernel(kernel, &all, layout.to_vec(), 4).unwrap();
+    run_built_oracle(ctx, build, &scene_gpu.buffers(frame), inputs, output_words, count)
+}
+
+/// Runs the oracle kernel `build` makes from the layout of `leading`, `inputs` and `Outputs`.
+fn run_built_oracle<T: bytemuck::Pod>(
+    ctx: &Arc<Context>,
+    build: impl FnOnce(&[BindingSlot]) -> Kernel,
+    leading: &[BoundBuffer],
+    inputs: &[(&'static str, &[u8])],
+    output_words: usize,
+    count: u32,
+) -> Vec<T> {
     let input_buffers: Vec<Buffer> = inputs
         .iter()
         .map(|(name, data)| Buffer::from_slice(ctx, name, data).unwrap())
@@ -82,7 +108,7 @@ pub fn run_oracle_with_defines<T: bytemuck::Pod>(
     }
     bindings.push(BindingSlot::storage(first + inputs.len() as u32, "Outputs").to(&output));
     let layout: Vec<BindingSlot> = bindings.iter().map(|b| b.slot).collect();
-    let k = Kernel::new(ctx, kernel, defines, &layout, 4).unwrap();
+    let k = build(&layout);
     k.bind(&bindings).unwrap();
     k.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
     let words = output.read::<u32>(output_words).unwrap();

@@ -16,7 +16,7 @@ use std::f32::consts::PI;
 use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::render::{Image, PathTracer, RenderSettings};
+use restir_pt::render::{Image, PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData, FILTER_LINEAR, WRAP_REPEAT};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
 use serde_json::json;
@@ -134,7 +134,7 @@ fn render(scene: &Scene, side: u32, spp: u32) -> Image {
         russian_roulette: false,
         camera: 0,
     };
-    let mut tracer = PathTracer::new(&ctx, scene, &settings).unwrap();
+    let mut tracer = PathTracer::new(&SceneGpu::upload(&ctx, scene).unwrap(), &settings).unwrap();
     tracer.render(&|_| {}, &AtomicBool::new(false)).unwrap();
     let image = tracer.image().unwrap();
     drop(tracer);

@@ -6,11 +6,12 @@
 use std::collections::HashSet;
 
 use glam::Vec3;
-use restir_pt::scene::{load_scene, Scene};
+use restir_pt::scene::Scene;
 use restir_pt::shading::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord};
 use restir_pt::shading::shift::*;
 
-use crate::common::{repo_path, TestRng};
+use crate::common::TestRng;
+use crate::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
 
 const IMAGE: u32 = 64;
 const RADIUS: f32 = 20.0;
@@ -95,7 +96,7 @@ fn near(a: f32, b: f32, tol: f32) -> bool {
 /// 1e-4, its contribution within 1e-3) and the base's vertices (within 1e-4 of the scene's
 /// extent); the Jacobians are reciprocal within 1e-3. Failed shifts carry no value.
 fn check_round_trips(name: &str, kind: Kind) -> Stats {
-    let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    let scene = scene_named(name);
     let params = ShiftParams::for_scene(&scene);
     let camera = scene.cameras[0].position;
     let tol = 1e-4 * scene.extent();
@@ -163,6 +164,7 @@ fn round_trip_all_scenes(kind: Kind) {
         "mirror",
         "veach-door",
         "env-ground",
+        NORMAL_MAPPED_BOX,
     ] {
         let stats = check_round_trips(name, kind);
         // Every shift must work somewhere in the diffuse Cornell box.
@@ -192,8 +194,8 @@ fn shift_hybrid_round_trip_and_jacobian_reciprocal() {
 
 /// Within a batch shifted into one target pixel, distinct base paths give distinct shifted paths.
 fn check_injective(kind: Kind) {
-    for name in ["cornell", "cornell-glossy", "near-field"] {
-        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    for name in ["cornell", "cornell-glossy", "near-field", NORMAL_MAPPED_BOX] {
+        let scene = scene_named(name);
         let params = ShiftParams::for_scene(&scene);
         let camera = scene.cameras[0].position;
         let y1 = primary_hit(&scene, 0, 31.5, 40.5, IMAGE, IMAGE).unwrap();
@@ -271,8 +273,8 @@ fn solid_angle(q: glam::DVec3, a: glam::DVec3, b: glam::DVec3, c: glam::DVec3) -
 /// solid angle a tiny triangle around x_r subtends from y_{r-1} over the one from x_{r-1}
 /// (the measure change of the reconnection), times the same pdf ratios. Within 1e-2 relative.
 fn check_jacobian_finite_difference(kind: Kind) {
-    for name in ["cornell", "cornell-glossy", "glass", "near-field"] {
-        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    for name in ["cornell", "cornell-glossy", "glass", "near-field", NORMAL_MAPPED_BOX] {
+        let scene = scene_named(name);
         let params = ShiftParams::for_scene(&scene);
         let camera = scene.cameras[0].position;
         let h = 1e-5 * scene.extent() as f64;
@@ -354,7 +356,7 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
     let mut total = Causes::default();
     let mut diverged = 0;
     for name in ["mirror", "glass", "near-field", "cornell", "veach-door"] {
-        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+        let scene = scene_named(name);
         let params = ShiftParams::for_scene(&scene);
         let camera = scene.cameras[0].position;
         for case in cases(&scene, 555, 4000) {

@@ -5,12 +5,12 @@
 
 use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
-use restir_pt::scene::{load_scene, Scene};
+use restir_pt::scene::Scene;
 use restir_pt::shading::path_record::PathRecord;
 use restir_pt::shading::shift::*;
 use restir_pt::vk::{Buffer, BufferUsage};
 
-use crate::common::repo_path;
+use crate::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
 use crate::shift::{cases, inverse, shift, Kind, BASE_PATHS};
 
 /// One shift to run on both sides: the record and the target domain's primary vertex.
@@ -91,11 +91,12 @@ fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, job
         .iter()
         .flat_map(|j| [j.v1.pos.extend(f32::from_bits(j.v1.triangle)), camera.extend(0.0)])
         .collect();
-    let out = crate::common::run_oracle_with_defines(
+    let out = crate::common::run_scene_oracle(
         &ctx,
+        &scene_gpu,
+        &frame,
         "oracle/shift_oracle.comp",
         &[("ORACLE_SHIFT", &function.to_string())],
-        &crate::common::as_storage(scene_gpu.buffers(&frame)),
         &[
             ("Params", bytemuck::cast_slice(&shift_params)),
             ("Records", bytemuck::cast_slice(&records)),
@@ -200,8 +201,8 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
 /// roughness threshold are excluded and counted (at most 1%).
 fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
     let function = if inverted { "inverse" } else { "shift" };
-    for name in ["cornell", "cornell-glossy", "glass", "near-field"] {
-        let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    for name in ["cornell", "cornell-glossy", "glass", "near-field", NORMAL_MAPPED_BOX] {
+        let scene = scene_named(name);
         let params = ShiftParams::for_scene(&scene);
         let camera = scene.cameras[0].position;
         let jobs = jobs(kind, inverted, &scene, &params, camera);

@@ -6,8 +6,8 @@ use glam::Vec3;
 
 use super::reconnection::ReconnectionTerms;
 use super::vertex::{
-    end_emission, end_mis_weight, hit_vertex, is_reconnectable, material_of, vertex_escaped, vertex_is_escaped, vertex_on_surface,
-    vertex_punctual, visible, ShiftParams, Vertex,
+    end_emission, end_mis_weight, hit_vertex, is_reconnectable, vertex_escaped, vertex_is_escaped, vertex_on_surface, vertex_punctual,
+    vertex_shading, visible, ShiftParams, Vertex,
 };
 use crate::gpu_types::{Material, NO_EMITTER};
 use crate::scene::bvh::{trace_closest, NO_HIT};
@@ -144,15 +144,15 @@ pub(super) fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32,
             return None;
         }
         let wo = (prev_pos - x.pos).normalize();
-        let m = material_of(scene, &x);
+        let (m, ns) = vertex_shading(scene, &x);
         let (next, lobe, weight) = if i + 1 == length && nee_end {
             let (ls, end) = nee_vertex(scene, &x, seed, i)?;
             if !visible(scene, &x, &end) {
                 return None;
             }
-            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, x.normal, wo, ls.dir).0 / ls.pdf)
+            (end, LOBE_NONE, bsdf_eval_pdf(&m, x.normal, ns, wo, ls.dir).0 / ls.pdf)
         } else {
-            let (s, next) = bsdf_vertex(scene, &x, wo, &m, seed, i)?;
+            let (s, next) = bsdf_vertex(scene, &x, wo, &m, ns, seed, i)?;
             (next, s.lobe, s.weight)
         };
         path.lobes.push(lobe);
@@ -180,11 +180,19 @@ pub(crate) fn nee_vertex(scene: &Scene, x: &Vertex, seed: u32, i: usize) -> Opti
     Some((ls, light))
 }
 
-/// The BSDF sample at x_i (material `m`, leaving towards `wo`) drawn with the path's random
-/// numbers, and the vertex its ray reaches (its hit, or the environment); `None` if no lobe was
-/// sampled.
-pub(crate) fn bsdf_vertex(scene: &Scene, x: &Vertex, wo: Vec3, m: &Material, seed: u32, i: usize) -> Option<(BsdfSample, Vertex)> {
-    let s = bsdf_sample(m, x.normal, x.normal, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
+/// The BSDF sample at x_i (material `m`, shading normal `ns` from `vertex_shading`, leaving
+/// towards `wo`) drawn with the path's random numbers, and the vertex its ray, offset along the
+/// geometric normal, reaches (its hit, or the environment); `None` if no lobe was sampled.
+pub(crate) fn bsdf_vertex(
+    scene: &Scene,
+    x: &Vertex,
+    wo: Vec3,
+    m: &Material,
+    ns: Vec3,
+    seed: u32,
+    i: usize,
+) -> Option<(BsdfSample, Vertex)> {
+    let s = bsdf_sample(m, x.normal, ns, wo, rng_uniform4(seed, i as u32, STREAM_BSDF));
     if s.lobe == LOBE_NONE {
         return None;
     }

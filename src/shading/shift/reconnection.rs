@@ -6,8 +6,8 @@ use glam::Vec3;
 
 use super::path::{reconnection_index, shift_failed, shift_ok, trace_vertices, Path, ShiftResult};
 use super::vertex::{
-    direction, end_emission, end_mis_weight, is_reconnectable, light_pdf, material_of, vertex_escaped, vertex_is_escaped,
-    vertex_is_punctual, vertex_on_surface, vertex_punctual, visible, ShiftParams, Vertex,
+    direction, end_emission, end_mis_weight, is_reconnectable, light_pdf, vertex_escaped, vertex_is_escaped, vertex_is_punctual,
+    vertex_on_surface, vertex_punctual, vertex_shading, visible, ShiftParams, Vertex,
 };
 use crate::scene::bvh::NO_HIT;
 use crate::scene::Scene;
@@ -143,13 +143,8 @@ struct Link {
 
 fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, nee_at_r: bool) -> Link {
     let (dir, dist) = direction(scene, prev, x_r);
-    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(
-        &material_of(scene, prev),
-        prev.normal,
-        prev.normal,
-        (before - prev.pos).normalize(),
-        dir,
-    );
+    let (m, ns) = vertex_shading(scene, prev);
+    let (f_cos, bsdf_pdf) = bsdf_eval_pdf(&m, prev.normal, ns, (before - prev.pos).normalize(), dir);
     let pdf = if nee_at_r { light_pdf(scene, prev, x_r) } else { bsdf_pdf };
     // A punctual x_r is one fixed point or direction whatever joins it: no area factor.
     let geometry = if vertex_is_escaped(x_r) || vertex_is_punctual(x_r) {
@@ -164,7 +159,8 @@ fn reconnection_link(scene: &Scene, prev: &Vertex, before: Vec3, x_r: &Vertex, n
 /// from x_r (the light's when NEE chose it).
 fn pdf_after(scene: &Scene, x_r: &Vertex, dir_in: Vec3, next: &Vertex, next_is_nee: bool) -> (Vec3, f32) {
     let (dir_next, _) = direction(scene, x_r, next);
-    let (f_cos, pdf) = bsdf_eval_pdf(&material_of(scene, x_r), x_r.normal, x_r.normal, -dir_in, dir_next);
+    let (m, ns) = vertex_shading(scene, x_r);
+    let (f_cos, pdf) = bsdf_eval_pdf(&m, x_r.normal, ns, -dir_in, dir_next);
     (f_cos, if next_is_nee { light_pdf(scene, x_r, next) } else { pdf })
 }
 

@@ -42,6 +42,8 @@ impl ShiftParams {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Vertex {
     pub pos: Vec3,
+    /// The geometric normal (unit, as wound; zero off surfaces); `vertex_shading` gives the
+    /// shading normal.
     pub normal: Vec3,
     pub triangle: u32,
 }
@@ -120,6 +122,16 @@ pub(crate) fn material_of(scene: &Scene, v: &Vertex) -> Material {
     scene.material_at(v.triangle, triangle_bary(&scene.triangles[v.triangle as usize], v.pos))
 }
 
+/// The material at surface vertex `v` (textures applied) and its shading normal `ns` (unit, world
+/// space): the path tracer's `Scene::hit_shading` (the interpolated vertex normal with the
+/// material's normal map applied; the geometric normal in a scene without shading normals).
+/// BSDFs evaluate in the frame of `ns`, as the path tracer's do, so that candidates, shifts and
+/// the path tracer share one target function; `v.normal` keeps deciding sides, ray offsets and
+/// the measure (docs/shift-mappings.md, "Shading frame").
+pub fn vertex_shading(scene: &Scene, v: &Vertex) -> (Material, Vec3) {
+    scene.hit_shading(v.triangle, triangle_bary(&scene.triangles[v.triangle as usize], v.pos))
+}
+
 /// Direction from `from` to `to` and the distance (infinite for an escaped `to`).
 pub(super) fn direction(scene: &Scene, from: &Vertex, to: &Vertex) -> (Vec3, f32) {
     if vertex_is_at_infinity(scene, to) {
@@ -194,7 +206,8 @@ pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee
         return if nee_end { 0.0 } else { 1.0 };
     }
     let (dir, _) = direction(scene, x, end);
-    let (_, bsdf_pdf) = bsdf_eval_pdf(&material_of(scene, x), x.normal, x.normal, (before - x.pos).normalize(), dir);
+    let (m, ns) = vertex_shading(scene, x);
+    let (_, bsdf_pdf) = bsdf_eval_pdf(&m, x.normal, ns, (before - x.pos).normalize(), dir);
     let light = light_pdf(scene, x, end);
     if nee_end {
         balance_heuristic(light, bsdf_pdf)
