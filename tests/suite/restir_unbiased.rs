@@ -245,6 +245,7 @@ fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
     assert!(failures.is_empty(), "{name}: biased against the path tracer: {failures:?}");
 }
 
+// The default settings (one spatial neighbour) in motion, with every shift and MIS.
 #[test]
 fn restir_unbiased_cornell() {
     check_unbiased(Unbiasedness {
@@ -262,7 +263,8 @@ fn restir_unbiased_cornell() {
 // A static camera keeps each pixel's domain from frame to frame: temporal reuse takes the
 // previous reservoir unshifted (same_domain in glsl/restir_reuse.glsl), and only spatial reuse
 // shifts. Two configurations keep the test's time down; the identity is the same for all. Two
-// reservoirs per pixel check that each keeps to its own layer's history and neighbours.
+// reservoirs per pixel check that each keeps to its own layer's history and neighbours, and
+// three neighbours (the default has one) the MIS weights of several inputs from other domains.
 #[test]
 fn restir_unbiased_cornell_static_camera() {
     check_unbiased(Unbiasedness {
@@ -276,13 +278,17 @@ fn restir_unbiased_cornell_static_camera() {
             (ShiftKind::Reconnection, ReuseMis::GeneralizedBalance),
             (ShiftKind::Hybrid, ReuseMis::Pairwise),
         ],
-        base: RestirSettings::default(),
+        base: RestirSettings {
+            spatial: 3,
+            ..Default::default()
+        },
     });
 }
 
 // The next frame's history is the reservoir before spatial reuse (ReSTIR GI's separate temporal
 // and spatial reservoirs) under a moving camera, with two spatial rounds, so that the second
-// round writes the previous frame's slot after the temporal pass has read it (frame_plan).
+// round writes the previous frame's slot after the temporal pass has read it (frame_plan);
+// three neighbours per round, so that each sample is inverse-shifted into several other domains.
 #[test]
 fn restir_unbiased_cornell_temporal_history() {
     check_unbiased(Unbiasedness {
@@ -298,6 +304,7 @@ fn restir_unbiased_cornell_temporal_history() {
         ],
         base: RestirSettings {
             history: History::Temporal,
+            spatial: 3,
             rounds: 2,
             ..Default::default()
         },
