@@ -58,7 +58,7 @@ pub struct ShardMeta {
     /// Image size in pixels.
     pub width: u32,
     pub height: u32,
-    /// The longest path, in bounces (`RenderSettings::max_depth`).
+    /// The longest path, in segments (`RenderSettings::max_depth`).
     pub max_depth: u32,
     /// Index into the scene's cameras.
     pub camera: usize,

@@ -12,14 +12,22 @@ use super::SceneInfo;
 pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
 pub const MAX_PIXELS: u64 = 1 << 26;
 
+/// What both renderers share: image, path length, randomness and camera. Check it with
+/// [`RenderSettings::validate`] before building a renderer.
 #[derive(Debug, Clone)]
 pub struct RenderSettings {
+    /// Image size in pixels (at most [`MAX_IMAGE_SIDE`] per side and [`MAX_PIXELS`] in all).
     pub width: u32,
     pub height: u32,
+    /// The path tracer's samples per pixel; ReSTIR PT ignores it.
     pub spp: u32,
+    /// The longest path, in segments from the camera (1: only emitters seen directly).
     pub max_depth: u32,
+    /// Seeds every random number of the render: equal settings and seed give equal images.
     pub seed: u32,
+    /// Russian roulette in the path tracer; ReSTIR PT traces every path to `max_depth`.
     pub russian_roulette: bool,
+    /// Index into the scene's cameras.
     pub camera: usize,
 }
 
@@ -81,6 +89,7 @@ impl RenderSettings {
         Ok(())
     }
 
+    /// `width * height`.
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize
     }
