@@ -4,9 +4,9 @@
 # time. Each item writes results.csv, rel_mse_vs_time.png and equal_time.png to
 # $DEST/<item>/ (the rest of compare's output stays in $WORK/<item>/).
 #
-# Usage: tools/make_results.sh [ITEM...]     (default: every item; hours on 2 CPU cores)
-# Items: static-veach-door static-cornell-glossy
-#        motion-veach-door-8 motion-veach-door-16 motion-cornell-glossy-8 motion-cornell-glossy-16
+# Usage: tools/make_results.sh [ITEM...]     (default: the README's items; hours on 2 CPU cores)
+# Items: static-veach-door static-cornell-glossy motion-veach-door-8 motion-cornell-glossy-8
+#        and, not in the README, motion-veach-door-16 motion-cornell-glossy-16
 # Environment: RESTIR_PT (binary; default target/release/restir-pt, built if missing),
 #   DEST (default docs/results), WORK (default out/make_results),
 #   REF_SPP (reference samples per pixel, default 4096) and TRIALS (runs per point, default the
@@ -22,8 +22,7 @@ if [[ -z ${RESTIR_PT:-} ]]; then
     [[ -x $RESTIR_PT ]] || cargo build --release
 fi
 
-ALL=(static-veach-door static-cornell-glossy
-     motion-veach-door-8 motion-veach-door-16 motion-cornell-glossy-8 motion-cornell-glossy-16)
+ALL=(static-veach-door static-cornell-glossy motion-veach-door-8 motion-cornell-glossy-8)
 
 # A reference of SCENE from CAMERA at SIZE×SIZE, made once per WORK folder.
 reference() {

@@ -12,7 +12,7 @@
 # by t. "vs @s0" is the same for spatial reuse on against off: relMSE × time of restir@s0 at t
 # over the row's.
 #
-# Usage: tools/motion_results.sh [ITEM...]   (default: the four motion items; about an hour on a
+# Usage: tools/motion_results.sh [ITEM...]   (default: the README's two 8-frame items; about half an hour on a
 #   quiet 2-core machine). Environment as tools/make_results.sh (RESTIR_PT, DEST, WORK, TRIALS);
 #   SUMMARY_ONLY=1 rewrites the summary from the results already in DEST.
 set -euo pipefail
@@ -20,7 +20,7 @@ cd "$(dirname "$0")/.."
 
 DEST=${DEST:-docs/results}
 items=("$@")
-[[ ${#items[@]} -gt 0 ]] || items=(motion-veach-door-8 motion-cornell-glossy-8 motion-veach-door-16 motion-cornell-glossy-16)
+[[ ${#items[@]} -gt 0 ]] || items=(motion-veach-door-8 motion-cornell-glossy-8)
 [[ -n ${SUMMARY_ONLY:-} ]] || DEST=$DEST tools/make_results.sh "${items[@]}"
 
 python3 - "$DEST" "${items[@]}" <<'EOF'
