@@ -242,6 +242,24 @@ BsdfSample sample_smooth_dielectric(Material m, vec3 wo, float w_t, float u, vec
     return s;
 }
 
+// The rough dielectric's direction wi from local wo (u.xy the visible normal, u.w reflection or
+// refraction): its lobe bits, LOBE_NONE when the sample fails.
+uint sample_rough_dielectric(vec3 wo, float alpha, float eta, vec4 u, out vec3 wi) {
+    float side = wo.z < 0.0 ? -1.0 : 1.0;
+    // Visible normals are sampled from wo mirrored through the origin, as the pdf assumes.
+    vec3 wm = sample_ggx_vndf(wo * side, alpha, u.xy);
+    float fr = fresnel_dielectric(dot(wo, wm), eta);
+    // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
+    // evaluated for the other event.
+    if (u.w < fr) {
+        wi = reflect(-wo, wm);
+        return wi.z * wo.z <= 0.0 ? LOBE_NONE : LOBE_DIELECTRIC;
+    }
+    float etap;
+    if (!refract_dir(wo, wm, eta, wi, etap) || wi.z * wo.z >= 0.0) return LOBE_NONE;
+    return LOBE_DIELECTRIC | LOBE_TRANSMISSION;
+}
+
 // bsdf_sample in the frame of normal n alone (no side checks).
 BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
     BsdfSample s = bsdf_sample_failed();
@@ -278,7 +296,6 @@ BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
         if (wi_s.z <= 0.0) return s;
         wi = wi_s * vec3(1.0, 1.0, side);
     } else if (BSDF_DIELECTRIC != 0 && w_t > 0.0) {
-        lobe = LOBE_DIELECTRIC;
         if (index_matched(m.ior)) {
             s.wi = -wo_world;
             s.weight = m.base_color;
@@ -287,19 +304,8 @@ BsdfSample bsdf_sample_frame(Material m, vec3 n, vec3 wo_world, vec4 u) {
             return s;
         }
         if (alpha < DELTA_ALPHA) return sample_smooth_dielectric(m, wo, w_t, u.w, t, b, n);
-        // Visible normals are sampled from wo mirrored through the origin, as the pdf assumes.
-        vec3 wm = sample_ggx_vndf(wo * side, alpha, u.xy);
-        float fr = fresnel_dielectric(dot(wo, wm), m.ior);
-        // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
-        // evaluated for the other event.
-        if (u.w < fr) {
-            wi = reflect(-wo, wm);
-            if (wi.z * wo.z <= 0.0) return s;
-        } else {
-            float etap;
-            if (!refract_dir(wo, wm, m.ior, wi, etap) || wi.z * wo.z >= 0.0) return s;
-            lobe |= LOBE_TRANSMISSION;
-        }
+        lobe = sample_rough_dielectric(wo, alpha, m.ior, u, wi);
+        if (lobe == LOBE_NONE) return s;
     } else {
         return s;
     }

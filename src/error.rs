@@ -3,26 +3,37 @@
 
 use ash::vk;
 
+/// A GPU failure; `during` and `what` name the operation or buffer, sizes are in bytes.
+/// Reach it from an `anyhow::Error` with `downcast_ref::<GpuError>()`.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
+    /// VK_ERROR_DEVICE_LOST: the device and everything made on it are unusable.
     #[error("the Vulkan device was lost (VK_ERROR_DEVICE_LOST) during {during}; the GPU work was abandoned")]
     DeviceLost { during: &'static str },
+    /// A submission's fence did not signal within `seconds`.
     #[error("a GPU submission did not finish within {seconds} s; the device is considered hung")]
     Timeout { seconds: u64 },
+    /// Device or host memory ran out (`bytes` is 0 when Vulkan did not say how much).
     #[error("out of GPU memory while allocating {what} ({bytes} bytes)")]
     OutOfMemory { what: String, bytes: u64 },
     /// The allocator refused for another reason than memory (no compatible memory type, a
     /// failed map, an internal error): gpu-allocator's `AllocationError` other than `OutOfMemory`.
     #[error("the GPU memory allocator could not allocate {what} ({bytes} bytes): {reason}")]
     Allocation { what: String, bytes: u64, reason: String },
+    /// A buffer larger than one storage-buffer binding may be.
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per storage-buffer binding (maxStorageBufferRange)")]
     BindingTooLarge { what: String, needed: u64, limit: u64 },
+    /// A buffer larger than one allocation may be.
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per allocation (maxMemoryAllocationSize)")]
     AllocationTooLarge { what: String, needed: u64, limit: u64 },
+    /// Any other failed Vulkan call, with its result code.
     #[error("Vulkan call failed during {during}: {result:?}")]
     Vulkan { during: &'static str, result: vk::Result },
+    /// Kernels count their loop iterations against the driver's budget (`limit` per loop and
+    /// invocation); `groups` subgroups ran out, having counted about `counted`.
     #[error("{groups} subgroup(s) of a dispatch ran out of the driver's loop budget ({limit} iterations per loop and shader invocation; about {counted} counted), which truncates paths: the render was stopped rather than written wrong")]
     LoopLimit { limit: u32, counted: u32, groups: u32 },
+    /// The validation layer (`ContextOptions::validation`) reported `count` messages.
     #[error("{count} Vulkan validation error(s) were reported; first: {first}")]
     Validation { count: u32, first: String },
 }

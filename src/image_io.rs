@@ -7,6 +7,11 @@ use glam::Vec3;
 
 use crate::render::Image;
 
+/// Writes `pixels` (`width * height`, row-major from the top left, linear RGB) as an RGB
+/// float EXR.
+///
+/// # Errors
+/// The file cannot be written; the message names `path`.
 pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<()> {
     let (w, h) = (width as usize, height as usize);
     exr::prelude::write_rgb_file(path, w, h, |x, y| {
@@ -16,6 +21,11 @@ pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Resul
     .map_err(|e| anyhow!("{}: cannot write EXR: {e}", path.display()))
 }
 
+/// Reads the first RGB(A) layer of an EXR: (width, height, row-major linear RGB pixels from the
+/// top left; alpha dropped).
+///
+/// # Errors
+/// The file cannot be read or holds no RGB layer; the message names `path`.
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
@@ -30,7 +40,9 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
 }
 
-pub(crate) fn srgb_encode(linear: f32) -> u8 {
+/// The 8-bit sRGB code of a linear value (IEC 61966-2-1 transfer function; clamped to [0, 1],
+/// rounded to nearest).
+pub fn srgb_encode(linear: f32) -> u8 {
     let c = linear.clamp(0.0, 1.0);
     let s = if c <= 0.0031308 {
         12.92 * c

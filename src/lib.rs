@@ -1,18 +1,58 @@
 //! restir-pt: a Vulkan compute path tracer with ReSTIR PT reuse through explicit shift mappings.
-//! Every GLSL function an oracle mirrors has a Rust twin of the same name in the matching module.
+//!
+//! The library is the renderer; the `restir-pt` binary (src/main.rs, src/app/) is one user of
+//! it. Embedding it takes four steps: load a [`scene::Scene`], open a [`vk::Context`], upload
+//! the scene once ([`render::SceneGpu::upload`]) and build renderers on the upload, as many as
+//! needed ([`render::PathTracer`] for progressive path tracing, [`render::Restir`] for ReSTIR
+//! PT frames). Images come back as [`render::Image`] (linear RGB, row-major from the top left);
+//! [`metrics`] compares them with a reference and [`image_io`] writes them.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use std::sync::{atomic::AtomicBool, Arc};
+//!
+//! use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
+//! use restir_pt::vk::{Context, ContextOptions};
+//!
+//! fn main() -> anyhow::Result<()> {
+//!     let scene = restir_pt::scene::load_scene(Path::new("scenes/cornell.gltf"))?;
+//!     let ctx = Arc::new(Context::new(&ContextOptions::default())?);
+//!     let uploaded = SceneGpu::upload(&ctx, &scene)?;
+//!     let settings = RenderSettings { width: 128, height: 128, spp: 256, ..Default::default() };
+//!     settings.validate(uploaded.info())?;
+//!
+//!     // A converged path-traced reference: `settings.spp` samples per pixel.
+//!     let mut tracer = PathTracer::new(&uploaded, &settings)?;
+//!     tracer.render(&|_done| {}, &AtomicBool::new(false))?;
+//!     let reference = tracer.image()?;
+//!
+//!     // Eight ReSTIR PT frames from camera 0, each reusing the last one's reservoirs.
+//!     let mut restir = Restir::new(&uploaded, &settings, &RestirSettings::default())?;
+//!     for _ in 0..8 {
+//!         restir.frame(0, false)?;
+//!     }
+//!     let image = restir.image()?;
+//!     println!("relMSE {:.3e}", restir_pt::metrics::rel_mse(&image.mean, &reference.mean));
+//!     restir_pt::image_io::write_exr(Path::new("restir.exr"), image.width, image.height, &image.mean)?;
+//!     // With `ContextOptions::validation` set, anything the validation layer reported fails here.
+//!     ctx.check_validation()?;
+//!     Ok(())
+//! }
+//! ```
+//!
+//! Errors are `anyhow::Error` with one readable line naming the file or the value at fault;
+//! GPU failures a caller may want to tell apart (device loss, out of memory, limits) are
+//! [`error::GpuError`] inside them. The shading code exists twice: every GLSL function an
+//! oracle test mirrors has a Rust twin of the same name in [`shading`] (or [`scene::bvh`]).
 
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-/// The `restir-pt` command-line application: its commands, option groups, sweeps and charts.
-/// Not part of the embedding API (no stability promise); it lives in the library only so that
-/// the binary and the test suite share it.
-#[doc(hidden)]
-pub mod app;
 pub mod error;
 pub mod gpu_types;
 pub mod image_io;
 pub mod metrics;
+pub mod reference_shard;
 pub mod render;
 pub mod scene;
 pub mod shader_interface;

@@ -1,10 +1,14 @@
-//! Command-line parsing and dispatch only; the commands and their options live in
-//! `restir_pt::app`.
+//! The `restir-pt` command-line application: parsing and dispatch here, the commands, their
+//! options, sweeps and charts in `app/`. It uses only the library's public API.
+
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+mod app;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use restir_pt::app;
 
 #[derive(Parser)]
 #[command(

@@ -6,6 +6,7 @@ use glam::Vec3;
 /// Guards relMSE's denominator where the reference is black (the usual 1e-2 of the literature).
 pub const REL_MSE_EPSILON: f32 = 1e-2;
 
+/// Relative luminance of linear Rec. 709 / sRGB primaries (ITU-R BT.709 weights).
 pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }

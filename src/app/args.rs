@@ -10,9 +10,9 @@ use glam::Vec3;
 
 use super::scene_path;
 use super::sweep::SweepMode;
-use crate::image_io::Exposure;
-use crate::render::{History, RenderSettings, RestirSettings, ReuseMis, ShiftKind};
-use crate::scene::{ArrayLimit, LoadOptions};
+use restir_pt::image_io::Exposure;
+use restir_pt::render::{History, RenderSettings, RestirSettings, ReuseMis, ShiftKind};
+use restir_pt::scene::{ArrayLimit, LoadOptions};
 
 /// An on/off switch written `--flag on|off`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

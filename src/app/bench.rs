@@ -12,8 +12,8 @@ use clap::Args;
 
 use super::args::{DeviceArgs, SceneArgs, SizeArgs, Toggle};
 use super::{finish_device, load_with_options, open_device};
-use crate::metrics::median;
-use crate::render::{PathTracer, RenderSettings, SceneGpu, SceneInfo, TraversalCounters};
+use restir_pt::metrics::median;
+use restir_pt::render::{PathTracer, RenderSettings, SceneGpu, SceneInfo, TraversalCounters};
 
 /// `restir-pt bench`.
 #[derive(Args, Debug, Clone)]

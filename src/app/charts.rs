@@ -11,7 +11,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::image_io::srgb_encode;
+use restir_pt::image_io::srgb_encode;
 
 /// Text needs a font to be measured and drawn; Debian's fonts-dejavu-core (tools/setup.sh) has it.
 const FONT_FILE: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";

@@ -17,10 +17,10 @@ use super::reference_record::check_reference;
 use super::render_output::status_spinner;
 use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path};
-use crate::image_io::read_exr;
-use crate::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};
-use crate::render::{Image, RenderSettings, SceneGpu, SceneInfo, MAX_RESERVOIRS};
-use crate::scene::{camera_on_path, Scene};
+use restir_pt::image_io::read_exr;
+use restir_pt::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};
+use restir_pt::render::{Image, RenderSettings, SceneGpu, SceneInfo, MAX_RESERVOIRS};
+use restir_pt::scene::{camera_on_path, Scene};
 
 /// `restir-pt compare`.
 #[derive(Args, Debug, Clone)]

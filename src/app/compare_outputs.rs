@@ -10,8 +10,8 @@ use glam::Vec3;
 use super::compare::{CompareArgs, CompareRow, Setup};
 use super::method_spec::MethodSpec;
 use crate::app::charts::{write_image_strip, write_line_chart, Inset, LineChart, Series, StripPanel};
-use crate::metrics::{rel_mse, rel_squared_error};
-use crate::render::Image;
+use restir_pt::metrics::{rel_mse, rel_squared_error};
+use restir_pt::render::Image;
 
 /// The inset window: the square (a quarter of the image's width) where `image` is furthest
 /// from the reference.
@@ -196,4 +196,44 @@ fn write_strip(
         pixels: &image.mean,
     }));
     write_image_strip(path, width, height, &panels, inset)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn compare_row(method: &str, gpu_ms_per_frame: f64, rel_mse: f64) -> CompareRow {
+        CompareRow {
+            method: method.to_string(),
+            budget_ms: 100.0,
+            knob: String::new(),
+            gpu_ms_per_frame,
+            rel_mse,
+            rel_mse_trimmed: rel_mse / 2.0,
+            mse: rel_mse,
+            energy_ratio: 1.0,
+            failed_shift_rate: None,
+            nonfinite_pixels: 0,
+        }
+    }
+
+    /// The equal-time ratio takes the best ReSTIR PT run within 20% of the budget; a run that
+    /// overshot it (here 190 ms for 100) is named and left out, however low its error.
+    #[test]
+    fn compare_equal_time_leaves_out_runs_over_budget() {
+        let rows = [
+            compare_row("pt", 95.0, 0.4),
+            compare_row("restir:reconnection/gbh", 110.0, 0.2),
+            compare_row("restir:hybrid/gbh", 190.0, 0.01),
+        ];
+        let lines = equal_time_lines(&rows, &[100.0]);
+        assert_eq!(
+            lines,
+            [
+                "equal time 100.0 ms: restir:hybrid/gbh left out, its frames took 190.0 ms",
+                "equal time 100.0 ms, relMSE: pt 4.0000e-1 (95.0 ms) / restir:reconnection/gbh 2.0000e-1 (110.0 ms) = 2.00x",
+                "equal time 100.0 ms, trimmed relMSE: pt 2.0000e-1 (95.0 ms) / restir:reconnection/gbh 1.0000e-1 (110.0 ms) = 2.00x",
+            ]
+        );
+    }
 }

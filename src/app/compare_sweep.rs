@@ -15,8 +15,8 @@ use super::sweep::{
     JobReport, SweepMode, COMMIT,
 };
 use super::{finish_device, open_device};
-use crate::image_io::{read_exr, write_exr};
-use crate::render::{Image, SceneGpu};
+use restir_pt::image_io::{read_exr, write_exr};
+use restir_pt::render::{Image, SceneGpu};
 
 const HEADER: &str = "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels";
 

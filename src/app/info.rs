@@ -4,13 +4,12 @@ use std::path::Path;
 
 use anyhow::Result;
 use clap::Args;
-use glam::Vec3;
 
 use super::args::{DeviceArgs, RestirArgs, SceneArgs};
 use super::{finish_device, load_with_options, open_device};
-use crate::render::{PathTracer, RenderSettings, Restir, SceneGpu};
-use crate::scene::Scene;
-use crate::vk::KernelCompile;
+use restir_pt::render::{PathTracer, RenderSettings, Restir, SceneGpu};
+use restir_pt::scene::Scene;
+use restir_pt::vk::KernelCompile;
 
 /// Materials listed one per line; vertex colours can make thousands of variants.
 const MAX_LISTED_MATERIALS: usize = 64;
@@ -45,7 +44,7 @@ pub fn info(args: InfoArgs) -> Result<()> {
         let settings = RenderSettings {
             width: 8,
             height: 8,
-            max_depth: crate::shading::path_record::MAX_PATH_LENGTH as u32,
+            max_depth: restir_pt::shading::path_record::MAX_PATH_LENGTH as u32,
             ..Default::default()
         };
         let scene_gpu = SceneGpu::upload(&ctx, &scene)?;
@@ -111,23 +110,23 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
             "environment: {}x{} equirectangular map (importance-sampled by luminance)",
             map.width, map.height
         ),
-        None => println!("environment: {:?}", scene.environment.to_array()),
+        None => println!("environment: {}", rounded(scene.environment.to_array())),
     }
     println!(
-        "bounds: {:?} .. {:?} (extent {:.4}), relative to the origin at {:?} (world; the first camera, else the centre of the bounds)",
-        lo.to_array(),
-        hi.to_array(),
-        scene.extent(),
-        scene.origin.to_array()
+        "bounds: {} .. {} (extent {}), relative to the origin at {} (world; the first camera, else the centre of the bounds)",
+        rounded(lo.to_array()),
+        rounded(hi.to_array()),
+        round_for_people(scene.extent() as f64),
+        rounded(scene.origin.to_array())
     );
     println!("punctual lights: {}", scene.lights.len());
     for (i, l) in scene.lights.iter().enumerate() {
         println!(
-            "  {i}: {:?} at {:?} along {:?}, intensity {:?}",
+            "  {i}: {:?} at {} along {}, intensity {}",
             l.kind,
-            l.position.to_array(),
-            l.direction.to_array(),
-            l.intensity.to_array()
+            rounded(l.position.to_array()),
+            rounded(l.direction.to_array()),
+            rounded(l.intensity.to_array())
         );
     }
     println!("materials: {}", scene.materials.len());
@@ -139,13 +138,13 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
         .take(MAX_LISTED_MATERIALS)
     {
         println!(
-            "  {name}: base {:?} metallic {} roughness {} transmission {} ior {} emission {:?}{} ({used} triangles)",
-            m.base_color,
-            m.metallic,
-            m.roughness,
-            m.transmission,
-            m.ior,
-            m.emission,
+            "  {name}: base {} metallic {} roughness {} transmission {} ior {} emission {}{} ({used} triangles)",
+            rounded(m.base_color),
+            round_for_people(m.metallic as f64),
+            round_for_people(m.roughness as f64),
+            round_for_people(m.transmission as f64),
+            round_for_people(m.ior as f64),
+            rounded(m.emission),
             if m.is_double_sided() { " double-sided" } else { "" }
         );
     }
@@ -154,16 +153,50 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
     }
     println!("cameras: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {
-        let p: Vec3 = c.position;
         println!(
-            "  {i}: {} at {:?} looking {:?}, yfov {:.2} deg",
+            "  {i}: {} at {} looking {}, yfov {:.2} deg",
             c.name,
-            p.to_array(),
-            c.forward.to_array(),
+            rounded(c.position.to_array()),
+            rounded(c.forward.to_array()),
             c.yfov.to_degrees()
         );
         if let Some(a) = c.aspect_ratio {
             println!("     aspect ratio {a:.4}");
         }
+    }
+}
+
+/// `x` to 4 significant digits, written as briefly as that value allows (3.9000000953674316
+/// prints 3.9, 11.999994 prints 12, -0 prints 0): the file's values as a person wrote them.
+fn round_for_people(x: f64) -> String {
+    if !x.is_finite() {
+        return x.to_string();
+    }
+    let four_digits: f64 = format!("{x:.3e}").parse().unwrap_or(x);
+    // Adding 0 turns -0 into 0.
+    (four_digits + 0.0).to_string()
+}
+
+/// A vector's components through [`round_for_people`], as `[x, y, z]`.
+fn rounded<T: Copy + Into<f64>, const N: usize>(v: [T; N]) -> String {
+    let parts: Vec<String> = v.iter().map(|&c| round_for_people(c.into())).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn info_rounds_numbers_to_four_significant_digits() {
+        assert_eq!(round_for_people(3.9000000953674316), "3.9");
+        assert_eq!(round_for_people(11.999994), "12");
+        assert_eq!(round_for_people(-0.0), "0");
+        assert_eq!(round_for_people(0.0), "0");
+        assert_eq!(round_for_people(0.05), "0.05");
+        assert_eq!(round_for_people(123456.0), "123500");
+        assert_eq!(round_for_people(-1.23456e-7), "-0.0000001235");
+        assert_eq!(round_for_people(f64::INFINITY), "inf");
+        assert_eq!(rounded([17.0f32, 11.999994, 3.999998]), "[17, 12, 4]");
     }
 }

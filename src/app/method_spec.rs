@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use anyhow::{bail, Result};
 
-use crate::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind, MAX_RESERVOIRS};
+use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind, MAX_RESERVOIRS};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum MethodSpec {

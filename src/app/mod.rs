@@ -4,7 +4,7 @@
 
 mod args;
 mod bench;
-pub mod charts;
+mod charts;
 mod compare;
 mod compare_outputs;
 mod compare_sweep;
@@ -19,27 +19,25 @@ mod shard;
 mod stability;
 mod sweep;
 
-pub use args::{parse_args, DeviceArgs, EnvArg, PathArgs, RestirArgs, SceneArgs, SizeArgs, SweepArgs, Toggle};
+pub use args::parse_args;
 pub use bench::{bench, BenchArgs};
-pub use compare::{compare, CompareArgs, CompareRow};
-pub use compare_outputs::equal_time_lines;
-pub use info::{info, triangles_per_material, InfoArgs};
-pub use method_spec::{MethodSpec, DEFAULT_METHODS};
+pub use compare::{compare, CompareArgs};
+pub use info::{info, InfoArgs};
 pub use profile::{profile, ProfileArgs};
-pub use reference::{reference, variance_path, ReferenceArgs};
-pub use render::{render, MethodArg, RenderArgs};
-pub use render_output::{RenderReport, RestirFrameReport};
-pub use shard::{merge, merge_shards, read_shard, MergeArgs, ShardMeta, ShardSpec, ShardSums};
-pub use stability::{bundled_scene_paths, stability, CameraMotion, StabilityArgs, StabilityRow};
-pub use sweep::{JobLine, JobReport, SweepMode, COMMIT};
+pub use reference::{reference, ReferenceArgs};
+pub use render::{render, RenderArgs};
+pub use shard::{merge, MergeArgs};
+pub use stability::{stability, StabilityArgs};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::Result;
 
-use crate::scene::{collapse_warnings, load_scene_reporting, LoadOptions, Scene};
-use crate::vk::{Context, ContextOptions};
+use restir_pt::scene::{collapse_warnings, load_scene_reporting, LoadOptions, Scene};
+use restir_pt::vk::{Context, ContextOptions};
+
+use args::DeviceArgs;
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell.gltf";
 

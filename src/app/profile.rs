@@ -11,9 +11,9 @@ use clap::Args;
 use super::args::{DeviceArgs, PathArgs, RestirArgs, SceneArgs, SizeArgs};
 use super::render_output::{compile_progress, print_compile_summary};
 use super::{finish_device, load_with_options, open_device};
-use crate::metrics::quantile;
-use crate::render::{RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_NAMES};
-use crate::scene::camera_on_path;
+use restir_pt::metrics::quantile;
+use restir_pt::render::{RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_NAMES};
+use restir_pt::scene::camera_on_path;
 
 /// `restir-pt profile`.
 #[derive(Args, Debug, Clone)]

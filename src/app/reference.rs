@@ -9,10 +9,10 @@ use clap::Args;
 use super::args::{DeviceArgs, PathArgs, SizeArgs};
 use super::reference_record::{scene_name, write_record, ReferenceRecord};
 use super::render_output::{create_parent, interrupt_flag, progress_bar};
-use super::shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
 use super::{finish_device, load_with_warnings, open_device, scene_path};
-use crate::image_io::write_exr;
-use crate::render::{Image, PathTracer, RenderSettings, RenderStats, SceneGpu, SceneInfo};
+use restir_pt::image_io::write_exr;
+use restir_pt::reference_shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
+use restir_pt::render::{Image, PathTracer, RenderSettings, RenderStats, SceneGpu, SceneInfo};
 
 /// `restir-pt reference`.
 #[derive(Args, Debug, Clone)]

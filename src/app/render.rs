@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{anyhow, bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 
 use super::args::{parse_exposure, DeviceArgs, PathArgs, RestirArgs, SceneArgs, Toggle};
@@ -14,9 +14,9 @@ use super::render_output::{
     RestirFrameReport,
 };
 use super::{finish_device, load_with_options, open_device};
-use crate::image_io::Exposure;
-use crate::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo};
-use crate::scene::{camera_on_path, Scene};
+use restir_pt::image_io::Exposure;
+use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo};
+use restir_pt::scene::{camera_on_path, Scene};
 
 /// The rendering method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -100,12 +100,12 @@ impl RenderArgs {
         (self.method == MethodArg::Restir).then(|| self.restir.settings())
     }
 
-    /// Refuses flags the method cannot honour and warns about flags it ignores.
-    fn check_method_flags(&self) -> Result<()> {
+    /// Warns about flags the method ignores (one line per method, naming them).
+    fn warn_ignored_flags(&self) {
         match self.method {
             MethodArg::Restir => {
                 if self.spp.is_some() {
-                    bail!("--spp sets the path tracer's samples; ReSTIR PT renders --frames frames of --candidates paths per pixel");
+                    eprintln!("warning: --spp is ignored by ReSTIR PT, which renders --frames frames of --candidates paths per pixel (--method pt uses it)");
                 }
                 if self.russian_roulette == Some(Toggle::On) {
                     eprintln!("warning: --russian-roulette on is ignored by ReSTIR PT, which traces every path to --max-depth (--method pt uses it)");
@@ -118,27 +118,53 @@ impl RenderArgs {
                 }
             }
         }
-        Ok(())
     }
 
     /// The render's settings on `scene`, validated.
     fn settings(&self, scene: &Scene) -> Result<RenderSettings> {
         let camera = scene.cameras.get(self.path.camera).unwrap_or(&scene.cameras[0]);
         let (width, height) = camera.image_size(self.width, self.height);
-        let settings = RenderSettings {
-            width,
-            height,
-            spp: self.spp.unwrap_or(RenderSettings::DEFAULT_SPP),
-            max_depth: self.path.max_depth,
-            seed: self.path.seed,
-            russian_roulette: self.russian_roulette.is_none_or(Toggle::on),
-            camera: self.path.camera,
-        };
+        let settings = self.settings_of_size(width, height);
         settings.validate(&SceneInfo::of(scene))?;
         if let Some(restir) = self.restir_settings() {
             restir.validate(settings.max_depth)?;
         }
         Ok(settings)
+    }
+
+    /// What [`RenderArgs::settings`] checks without the scene, and that the scene file can be
+    /// opened, so that bad input fails before the device opens (a second or more on lavapipe).
+    /// The image size is checked here when both sides are given; a side the camera completes
+    /// waits for the scene.
+    fn check_before_device(&self, scene_path: &Path) -> Result<()> {
+        std::fs::File::open(scene_path).map_err(|e| anyhow!("{}: cannot read the file: {e}", scene_path.display()))?;
+        let (width, height) = match (self.width, self.height) {
+            (Some(w), Some(h)) => (w, h),
+            // A valid stand-in: only spp and depth are checked.
+            _ => (1, 1),
+        };
+        self.settings_of_size(width, height).validate_numbers()?;
+        if let Some(restir) = self.restir_settings() {
+            restir.validate(self.path.max_depth)?;
+        }
+        Ok(())
+    }
+
+    /// The settings of an image of `width` x `height`, unchecked.
+    fn settings_of_size(&self, width: u32, height: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            // ReSTIR PT ignores --spp (warn_ignored_flags says so), so its value is not checked.
+            spp: self
+                .spp
+                .filter(|_| self.method == MethodArg::Pt)
+                .unwrap_or(RenderSettings::DEFAULT_SPP),
+            max_depth: self.path.max_depth,
+            seed: self.path.seed,
+            russian_roulette: self.russian_roulette.is_none_or(Toggle::on),
+            camera: self.path.camera,
+        }
     }
 
     /// The scene camera of frame `frame`: --camera for a static camera, else the scene's camera
@@ -214,7 +240,7 @@ impl Job<'_> {
         frame: u32,
         report: &RenderReport,
         line: &str,
-        image: Option<&crate::render::Image>,
+        image: Option<&restir_pt::render::Image>,
         interrupted: bool,
     ) -> Result<bool> {
         println!("{}{line}", self.args.frame_prefix(frame, self.scene.info().cameras.len()));
@@ -255,8 +281,9 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    args.check_method_flags()?;
+    args.warn_ignored_flags();
     let path = args.scene.path();
+    args.check_before_device(&path)?;
     // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;

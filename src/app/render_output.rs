@@ -8,9 +8,9 @@ use std::sync::Arc;
 use anyhow::{bail, Context as _, Result};
 use serde::Serialize;
 
-use crate::image_io::{exposure_ev, write_exr, write_png_exposed, Exposure};
-use crate::metrics::median;
-use crate::render::{FrameStats, Image, PASS_NAMES};
+use restir_pt::image_io::{exposure_ev, write_exr, write_png_exposed, Exposure};
+use restir_pt::metrics::median;
+use restir_pt::render::{FrameStats, Image, PASS_NAMES};
 
 /// The JSON report of `render --report` and the numbers of its summary lines.
 #[derive(Serialize)]
@@ -189,7 +189,7 @@ pub fn status_spinner() -> indicatif::ProgressBar {
 }
 
 /// The start-up line: how long compiling the kernels took.
-pub fn print_compile_summary(kernels: &[crate::vk::KernelCompile]) {
+pub fn print_compile_summary(kernels: &[restir_pt::vk::KernelCompile]) {
     let total: f64 = kernels.iter().map(|k| k.total_ms()).sum();
     eprintln!("start-up: {} kernel(s) compiled in {total:.0} ms", kernels.len());
 }

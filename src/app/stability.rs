@@ -23,9 +23,9 @@ use super::sweep::{
 };
 use super::{bundled_file, finish_device, load_with_warnings, open_device};
 use crate::app::charts::{write_line_chart, LineChart, Series};
-use crate::metrics::{energy_ratio, flicker, mean, rel_mse};
-use crate::render::{PathTracer, RenderSettings, SceneGpu, SceneInfo};
-use crate::scene::{camera_on_path, Scene};
+use restir_pt::metrics::{energy_ratio, flicker, mean, rel_mse};
+use restir_pt::render::{PathTracer, RenderSettings, SceneGpu, SceneInfo};
+use restir_pt::scene::{camera_on_path, Scene};
 
 /// `restir-pt stability`.
 #[derive(Args, Debug, Clone)]
@@ -139,7 +139,7 @@ fn scene_name(path: &Path) -> String {
 
 /// The bundled scenes, in their documented order.
 pub fn bundled_scene_paths() -> Vec<PathBuf> {
-    crate::scene::bundled_scenes::BUNDLED_SCENES
+    restir_pt::scene::bundled_scenes::BUNDLED_SCENES
         .iter()
         .map(|s| bundled_file(&Path::new("scenes").join(s.file_name)))
         .collect()

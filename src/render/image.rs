@@ -2,10 +2,13 @@
 
 use glam::Vec3;
 
+/// A rendered image: `width * height` pixels, row-major from the top left, linear RGB radiance.
 #[derive(Debug, Clone)]
 pub struct Image {
+    /// Size in pixels.
     pub width: u32,
     pub height: u32,
+    /// The pixel estimates (the mean of their samples).
     pub mean: Vec<Vec3>,
     /// Variance of the pixel estimate (the sample variance divided by the sample count).
     pub variance: Vec<Vec3>,
@@ -42,10 +45,12 @@ impl Image {
         }
     }
 
+    /// Pixels whose mean has a NaN or infinite channel (a correct render has none).
     pub fn non_finite_count(&self) -> usize {
         self.mean.iter().filter(|p| !p.is_finite()).count()
     }
 
+    /// The mean over all pixels (NaN if any pixel is).
     pub fn average(&self) -> Vec3 {
         self.mean.iter().fold(Vec3::ZERO, |a, &p| a + p) / self.mean.len() as f32
     }

@@ -53,6 +53,8 @@ impl RenderStats {
 
 pub use super::image_readback::PixelSums;
 
+/// The progressive path tracer of one uploaded scene at one resolution: accumulates paths per
+/// pixel over adaptive submissions (`render`) and reads back their mean and variance (`image`).
 pub struct PathTracer {
     ctx: Arc<Context>,
     kernel: Kernel,

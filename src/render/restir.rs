@@ -54,6 +54,8 @@ impl FrameStats {
     }
 }
 
+/// ReSTIR PT on one uploaded scene at one resolution: one `frame` per camera pose, with the
+/// temporal history and the running average of a static camera kept between frames.
 pub struct Restir {
     ctx: Arc<Context>,
     /// The frame's kernels, indexed by `PassKernel as usize`.

@@ -29,9 +29,14 @@ pub struct SceneGpu {
     ctx: Arc<Context>,
     /// The host data of the scene these buffers hold.
     info: SceneInfo,
+    /// `Triangle` records (glsl/types.glsl), one per scene triangle (one placeholder if none).
     pub triangles: Buffer,
+    /// The BVH's `BvhNode` records, root first.
     pub nodes: Buffer,
+    /// `Material` records, indexed by a triangle's material (one default if none).
     pub materials: Buffer,
+    /// `Emitter` rows: emissive triangles, then `PUNCTUAL_ROWS` per punctual light, then the
+    /// environment map's sampling rows.
     pub emitters: Buffer,
     /// Scene arrays are bound as uniform buffers (CPU devices, small scenes), else storage buffers.
     pub uniform: bool,

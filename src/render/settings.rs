@@ -50,6 +50,21 @@ impl RenderSettings {
     /// [`SceneInfo::of`] before upload, or [`SceneGpu::info`](super::SceneGpu::info)). Errors:
     /// one line naming the bad value (and the scene's file for a missing camera).
     pub fn validate(&self, scene: &SceneInfo) -> Result<()> {
+        self.validate_numbers()?;
+        if self.camera >= scene.cameras.len() {
+            bail!(
+                "{}: --camera {} does not exist; the scene has {} camera(s)",
+                scene.source.display(),
+                self.camera,
+                scene.cameras.len()
+            );
+        }
+        Ok(())
+    }
+
+    /// The part of [`RenderSettings::validate`] that needs no scene: image size, spp and depth.
+    /// Errors: one line naming the bad value.
+    pub fn validate_numbers(&self) -> Result<()> {
         let (w, h) = (self.width, self.height);
         if w == 0 || h == 0 {
             bail!("resolution {w}x{h} is empty: width and height must be at least 1");
@@ -62,14 +77,6 @@ impl RenderSettings {
         }
         if self.max_depth == 0 {
             bail!("--max-depth must be at least 1 (1 shows only directly visible emitters)");
-        }
-        if self.camera >= scene.cameras.len() {
-            bail!(
-                "{}: --camera {} does not exist; the scene has {} camera(s)",
-                scene.source.display(),
-                self.camera,
-                scene.cameras.len()
-            );
         }
         Ok(())
     }

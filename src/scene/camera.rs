@@ -13,9 +13,13 @@ pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(0.0, 0.447_213_6, 0.894_427_2
 /// Vertical field of view of the default camera (45 degrees).
 pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
+/// A pinhole camera (glTF perspective camera; the image plane at distance 1 along `forward`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Camera {
+    /// The glTF node's or camera's name.
     pub name: String,
+    /// Position in scene coordinates and an orthonormal frame: `forward` is the viewing
+    /// direction, `up` and `right` span the image plane.
     pub position: Vec3,
     pub forward: Vec3,
     pub up: Vec3,
@@ -63,6 +67,8 @@ impl Camera {
         }
     }
 
+    /// A camera at `eye` looking at `target`, with `up` as the image's vertical (not parallel
+    /// to the view direction) and a vertical field of view of `yfov` radians.
     pub fn look_at(name: &str, eye: Vec3, target: Vec3, up: Vec3, yfov: f32) -> Camera {
         let forward = (target - eye).normalize();
         let right = forward.cross(up).normalize();

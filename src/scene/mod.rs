@@ -21,6 +21,8 @@ pub use gltf_material::spec_gloss_to_metal_rough;
 pub use gltf_mesh::triangle_indices;
 pub use punctual::{PunctualKind, PunctualLight};
 
+pub use crate::metrics::luminance;
+
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
@@ -34,17 +36,25 @@ use crate::shading::texture::SceneTextures;
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
 
+/// A scene ready to upload: what [`load_scene`] returns and the renderers draw. Positions are
+/// in scene coordinates (world minus [`Scene::origin`], metres as the file has them).
 pub struct Scene {
+    /// The file it was loaded from (or a description for scenes built in code).
     pub source: PathBuf,
+    /// Triangles in BVH leaf order, each with its material and emitter index.
     pub triangles: Vec<Triangle>,
     /// Vertex attributes of `triangles` (same order), or empty: a scene of flat faces without
     /// textures has none (see src/surface.rs).
     pub surfaces: Vec<TriangleSurface>,
     /// The materials' textures (empty: none).
     pub textures: SceneTextures,
+    /// The BVH over `triangles`, in depth-first order with skip links (src/scene/bvh.rs).
     pub nodes: Vec<BvhNode>,
+    /// Materials by index (`Triangle::material`), and their names from the file.
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
+    /// Light-sampling table: emissive triangles then punctual lights, each with its alias-table
+    /// entry and selection pdf.
     pub emitters: Vec<Emitter>,
     /// Total emitted power of the emissive triangles (W, luminance-weighted, front faces).
     pub emitter_power: f32,
@@ -52,7 +62,10 @@ pub struct Scene {
     pub environment: Vec3,
     /// An equirectangular environment map (`--env FILE`), replacing the constant.
     pub environment_map: Option<EnvironmentMap>,
+    /// Probability that next-event estimation samples the environment rather than the emitter
+    /// table (0 without environment light, 1 without emitters).
     pub env_select_prob: f32,
+    /// The file's cameras, or one default camera framing the scene; never empty.
     pub cameras: Vec<Camera>,
     /// `KHR_lights_punctual` lights in scene coordinates (like the triangles: relative to
     /// [`Scene::origin`]).
@@ -71,11 +84,8 @@ pub struct Scene {
     pub build_ms: f64,
 }
 
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
-
 /// Input to [`Scene::build`]: triangles as loaded, each tagged with its material.
+/// Fields mean what the [`Scene`] fields of the same names mean; `triangles` in any order.
 pub struct SceneParts {
     pub source: PathBuf,
     pub triangles: Vec<Triangle>,
@@ -186,6 +196,7 @@ impl Scene {
         crate::gpu_types::punctual_rows(&self.lights, &pdfs)
     }
 
+    /// The largest side of the scene's bounds (scene units).
     pub fn extent(&self) -> f32 {
         (self.bounds.1 - self.bounds.0).max_element()
     }

@@ -287,6 +287,25 @@ pub fn sample_smooth_dielectric(m: &Material, wo: Vec3, w_t: f32, u: f32, frame:
     }
 }
 
+/// The rough dielectric's (direction, lobe bits) from local `wo` (u.xy the visible normal, u.w
+/// reflection or refraction); `None` when the sample fails. Twin of GLSL `sample_rough_dielectric`.
+pub fn sample_rough_dielectric(wo: Vec3, alpha: f32, eta: f32, u: Vec4) -> Option<(Vec3, u32)> {
+    let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
+    // Visible normals are sampled from wo mirrored through the origin, as the pdf assumes.
+    let wm = sample_ggx_vndf(wo * side, alpha, u.truncate().truncate());
+    let fr = fresnel_dielectric(wo.dot(wm), eta);
+    // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
+    // evaluated for the other event.
+    if u.w < fr {
+        let wi = reflect(-wo, wm);
+        return (wi.z * wo.z > 0.0).then_some((wi, LOBE_DIELECTRIC));
+    }
+    match refract_dir(wo, wm, eta) {
+        Some((wt, _)) if wt.z * wo.z < 0.0 => Some((wt, LOBE_DIELECTRIC | LOBE_TRANSMISSION)),
+        _ => None,
+    }
+}
+
 /// [`bsdf_sample`] in the frame of normal `n` alone (no side checks). Twin of GLSL
 /// `bsdf_sample_frame`.
 pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> BsdfSample {
@@ -303,7 +322,6 @@ pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> Bsdf
     let wo_s = wo * flip;
     let layer = w_d * specular_layer_fresnel(m, wo_s.z);
     let p_layer = layer.max_element();
-    let mirrored = Vec3::new(-wo.x, -wo.y, wo.z);
     // Lobe choice: diffuse w_d - p_layer, GGX reflection w_c + p_layer, dielectric w_t.
     let (wi, lobe) = if u.z < w_d - p_layer {
         (sample_cosine_hemisphere(u.truncate().truncate()) * flip, LOBE_DIFFUSE)
@@ -311,7 +329,7 @@ pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> Bsdf
         if alpha < DELTA_ALPHA {
             let pdf = w_c + p_layer;
             return BsdfSample {
-                wi: to_world(mirrored, t, b, n),
+                wi: to_world(Vec3::new(-wo.x, -wo.y, wo.z), t, b, n),
                 weight: (w_c * fresnel_schlick(base, wo_s.z) + layer) / pdf,
                 pdf,
                 lobe: LOBE_CONDUCTOR | LOBE_DELTA,
@@ -340,21 +358,9 @@ pub fn bsdf_sample_frame(m: &Material, n: Vec3, wo_world: Vec3, u: Vec4) -> Bsdf
         if alpha < DELTA_ALPHA {
             return sample_smooth_dielectric(m, wo, w_t, u.w, (t, b, n));
         }
-        let wm = sample_ggx_vndf(wo * side, alpha, u.truncate().truncate());
-        let fr = fresnel_dielectric(wo.dot(wm), m.ior);
-        // A reflection must stay on wo's side and a refraction must cross, or the pdf would be
-        // evaluated for the other event.
-        if u.w < fr {
-            let wi = reflect(-wo, wm);
-            if wi.z * wo.z <= 0.0 {
-                return BsdfSample::FAILED;
-            }
-            (wi, LOBE_DIELECTRIC)
-        } else {
-            match refract_dir(wo, wm, m.ior) {
-                Some((wt, _)) if wt.z * wo.z < 0.0 => (wt, LOBE_DIELECTRIC | LOBE_TRANSMISSION),
-                _ => return BsdfSample::FAILED,
-            }
+        match sample_rough_dielectric(wo, alpha, m.ior, u) {
+            Some(sample) => sample,
+            None => return BsdfSample::FAILED,
         }
     };
     let (f_cos, pdf) = bsdf_eval_pdf_local(m, wo, wi);

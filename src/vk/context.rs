@@ -17,6 +17,7 @@ const LLVMPIPE_LOOP_LIMIT: u32 = 65535;
 /// One submission must never block the caller forever; a healthy chunk finishes in well under this.
 const FENCE_TIMEOUT_NS: u64 = 120_000_000_000;
 
+/// How [`Context::new`] picks and sets up the device.
 #[derive(Debug, Clone, Default)]
 pub struct ContextOptions {
     /// Device name substring or index in enumeration order; `None` picks the best device.
@@ -29,10 +30,13 @@ pub struct ContextOptions {
     pub scene_binding_limit: Option<u64>,
 }
 
+/// What the chosen device is and the limits the renderers plan around.
 #[derive(Debug, Clone)]
 pub struct DeviceInfo {
+    /// The driver's device name (e.g. "llvmpipe (LLVM 15.0.7, 256 bits)").
     pub name: String,
     pub device_type: vk::PhysicalDeviceType,
+    /// maxStorageBufferRange and maxUniformBufferRange, in bytes.
     pub max_storage_buffer_range: u64,
     pub max_uniform_buffer_range: u64,
     /// Bytes one scene array may take in a binding (maxStorageBufferRange, or less where
@@ -45,6 +49,8 @@ pub struct DeviceInfo {
     pub max_allocation_bytes: u64,
     /// Bytes of shared memory a compute workgroup may use (Vulkan's floor: 16384).
     pub max_compute_shared_memory: u32,
+    /// Nanoseconds per timestamp tick (timestampPeriod), and whether the compute queue writes
+    /// timestamps at all (GPU times are reported as 0 where it does not).
     pub timestamp_period_ns: f32,
     pub timestamps_supported: bool,
     /// Iterations each loop of one shader invocation may run in total before the driver silently
@@ -60,6 +66,7 @@ pub struct ValidationLog {
 }
 
 impl ValidationLog {
+    /// The messages counted so far (errors and warnings), in order.
     pub fn messages(&self) -> Vec<String> {
         self.errors.lock().map(|e| e.clone()).unwrap_or_default()
     }
@@ -87,18 +94,24 @@ unsafe extern "system" fn debug_callback(
     vk::FALSE
 }
 
+/// One Vulkan device with its compute queue, memory allocator and (optionally) validation
+/// messenger: what every buffer, kernel and renderer is made on, shared as `Arc<Context>`
+/// (each of them holds a clone).
 pub struct Context {
     allocator: ManuallyDrop<Mutex<Allocator>>,
     command_pool: vk::CommandPool,
+    /// The raw handles, for code that records its own Vulkan work.
     pub queue: vk::Queue,
     pub queue_family: u32,
     pub device: ash::Device,
     pub physical_device: vk::PhysicalDevice,
+    /// The device's name and limits.
     pub info: DeviceInfo,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     validation_log: Arc<ValidationLog>,
     /// Compute pipelines created on this device (see `pipelines_created`).
     pipelines: std::sync::atomic::AtomicU64,
+    /// The raw instance handle.
     pub instance: ash::Instance,
     _entry: ash::Entry,
 }
@@ -121,6 +134,13 @@ fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
 }
 
 impl Context {
+    /// Loads Vulkan, picks a device (`options.device`, else the first discrete, integrated,
+    /// virtual then CPU device) and creates the queue, allocator and messenger.
+    ///
+    /// # Errors
+    /// One line: no Vulkan loader, validation asked for without the layer installed, no device,
+    /// no device matching `options.device` (the available ones listed), or a failed Vulkan
+    /// call ([`GpuError`]).
     pub fn new(options: &ContextOptions) -> Result<Self> {
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| anyhow!("cannot load the Vulkan loader (libvulkan.so.1): {e}; run tools/setup.sh"))?;
@@ -175,6 +195,8 @@ impl Context {
         })
     }
 
+    /// The device's memory allocator, locked (a poisoned lock is recovered: the allocator
+    /// holds no invariant a panic elsewhere could break).
     pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
         self.allocator.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }

@@ -1,5 +1,5 @@
 //! GLSL bsdf.glsl against src/shading/bsdf.rs: bsdf_eval_pdf and bsdf_sample (through
-//! bsdf_sample_frame and, for smooth dielectrics, sample_smooth_dielectric) on random materials,
+//! bsdf_sample_frame, sample_smooth_dielectric and sample_rough_dielectric) on random materials,
 //! normals, directions and uniforms, plus sample/pdf consistency of the Rust model.
 
 use glam::{Vec3, Vec4};

@@ -65,8 +65,8 @@ fn cli_static_camera_path_tracing_averages_its_frames() {
     assert_eq!(json["spp"].as_u64().unwrap(), 6, "{json}");
 }
 
-/// ReSTIR-only flags with the path tracer, and Russian roulette asked of ReSTIR PT, are named in
-/// a warning; the frame line of ReSTIR PT gives the non-finite counts once.
+/// ReSTIR-only flags with the path tracer, and Russian roulette or --spp given to ReSTIR PT, are
+/// named in a warning; the frame line of ReSTIR PT gives the non-finite counts once.
 #[test]
 fn cli_flags_the_method_ignores_are_named() {
     let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
@@ -87,12 +87,14 @@ fn cli_flags_the_method_ignores_are_named() {
     let (code, _, stderr) = restir_pt(&[&["render", "--method", "pt", "--spp", "1", "--shift", "hybrid"], &tiny[..]].concat());
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("warning"), "a default value is no reason to warn: {stderr}");
-    let (code, stdout, stderr) = restir_pt(&[&["render", "--russian-roulette", "on", "--frames", "2"], &tiny[..]].concat());
+    // --spp is ignored by ReSTIR PT like --russian-roulette, even a value the path tracer refuses.
+    let (code, stdout, stderr) = restir_pt(&[&["render", "--russian-roulette", "on", "--spp", "0", "--frames", "2"], &tiny[..]].concat());
     assert_eq!(code, 0, "{stderr}");
     assert!(
         stderr.contains("warning: --russian-roulette on is ignored by ReSTIR PT"),
         "{stderr}"
     );
+    assert!(stderr.contains("warning: --spp is ignored by ReSTIR PT"), "{stderr}");
     let line = stdout.lines().find(|l| l.starts_with("frame 1 | ")).expect("a line per frame");
     assert_eq!(line.matches("non-finite").count(), 1, "{line}");
     assert!(line.contains("non-finite pixels 0, weights 0"), "{line}");

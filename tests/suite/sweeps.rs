@@ -109,7 +109,7 @@ fn sweeps_reference_shards_merge_into_the_one_process_reference() {
 /// The shards' sums are disjoint shares: shard 0 of 3 alone is a different, 4-spp estimate.
 fn assert_shard_alone_differs(whole: &Path, shard: &Path) {
     let (_, _, one) = restir_pt::image_io::read_exr(whole).unwrap();
-    let shard0 = restir_pt::app::read_shard(shard).unwrap();
+    let shard0 = restir_pt::reference_shard::read_shard(shard).unwrap();
     assert_eq!((shard0.meta.first_sample, shard0.meta.spp, shard0.sums[0][3]), (0, 4, 4.0));
     let differs = shard0
         .sums
@@ -170,11 +170,20 @@ fn check_merge_problems(dir: &Path, whole: &Path, shards: &[PathBuf]) {
     assert!(!dir.join("x.exr").exists());
 }
 
+/// A line of a plan (jobs.jsonl) as docs/cluster.md describes it: the fields the scripts read.
+#[derive(serde::Deserialize)]
+struct JobLine {
+    job: usize,
+    jobs: usize,
+    argv: Vec<String>,
+    merge_argv: Vec<String>,
+}
+
 /// Runs every job of the plan at `plan` as the cluster scripts do (each line's argv from its
 /// cwd), then its merge command; returns the merge's stdout.
 fn run_plan(plan: &Path, jobs: usize) -> String {
     let text = std::fs::read_to_string(plan).unwrap();
-    let lines: Vec<restir_pt::app::JobLine> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lines: Vec<JobLine> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(lines.len(), jobs, "{text}");
     for (k, line) in lines.iter().enumerate() {
         assert_eq!((line.job, line.jobs), (k, jobs));

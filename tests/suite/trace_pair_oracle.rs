@@ -134,7 +134,7 @@ fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
     );
 
     // The Cornell box is small enough for uniform buffers on lavapipe: both forms there.
-    let cornell = load_scene(&restir_pt::app::bundled_file("scenes/cornell.gltf".as_ref())).unwrap();
+    let cornell = load_scene(&crate::common::repo_path("scenes/cornell.gltf")).unwrap();
     // The loader re-centres a scene on its first camera: the box is around its bounds' centre.
     let (lo, hi) = cornell.bounds;
     let pairs = random_pairs(7, 0.5 * (lo + hi), 0.99);
