@@ -86,25 +86,31 @@ fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, job
             Kind::Hybrid => 2,
         };
     let shift_params = [0, params.roughness_threshold.to_bits(), params.distance_threshold.to_bits(), 0];
-    let records: Vec<PathRecord> = jobs.iter().map(|j| j.record).collect();
-    let targets: Vec<Vec4> = jobs
-        .iter()
-        .flat_map(|j| [j.v1.pos.extend(f32::from_bits(j.v1.triangle)), camera.extend(0.0)])
-        .collect();
-    let out = crate::common::run_scene_oracle(
-        &ctx,
-        &scene_gpu,
-        &frame,
-        "oracle/shift_oracle.comp",
-        &[("ORACLE_SHIFT", &function.to_string())],
-        &[
-            ("Params", bytemuck::cast_slice(&shift_params)),
-            ("Records", bytemuck::cast_slice(&records)),
-            ("Targets", bytemuck::cast_slice(&targets)),
-        ],
-        jobs.len() * 13 * 4,
-        jobs.len() as u32,
-    );
+    let mut out = Vec::with_capacity(jobs.len() * 13);
+    // Dispatches of a few thousand shifts each: on a loaded machine one dispatch of 10^4 whole
+    // paths can outlast the fence timeout (120 s). Every chunk after the first finds its
+    // kernel in the shader cache.
+    for chunk in jobs.chunks(2500) {
+        let records: Vec<PathRecord> = chunk.iter().map(|j| j.record).collect();
+        let targets: Vec<Vec4> = chunk
+            .iter()
+            .flat_map(|j| [j.v1.pos.extend(f32::from_bits(j.v1.triangle)), camera.extend(0.0)])
+            .collect();
+        out.extend(crate::common::run_scene_oracle::<Vec4>(
+            &ctx,
+            &scene_gpu,
+            &frame,
+            "oracle/shift_oracle.comp",
+            &[("ORACLE_SHIFT", &function.to_string())],
+            &[
+                ("Params", bytemuck::cast_slice(&shift_params)),
+                ("Records", bytemuck::cast_slice(&records)),
+                ("Targets", bytemuck::cast_slice(&targets)),
+            ],
+            chunk.len() * 13 * 4,
+            chunk.len() as u32,
+        ));
+    }
     crate::common::assert_clean(&ctx);
     out
 }
