@@ -402,8 +402,11 @@ fn check_alpha_masked_cornell(configurations: &'static [(ShiftKind, ReuseMis)]) 
 }
 
 // Every shift's vertices and visibility tests must see the same holes in the screen. The hybrid
-// shift reconnects and replays; the other shifts are in the ignored test below.
+// shift reconnects and replays; the other shifts are in the second test. Both are ignored: alpha
+// testing makes this scene's 4096-spp reference 5.7 times slower than cornell's (over 40 minutes
+// on the loaded 2-core machine with the rest of the suite).
 #[test]
+#[ignore = "minutes; run with --ignored (docs/restir.md)"]
 fn restir_unbiased_alpha_masked_cornell() {
     check_alpha_masked_cornell(&[(ShiftKind::Hybrid, ReuseMis::GeneralizedBalance)]);
 }
