@@ -147,6 +147,21 @@ impl RenderArgs {
         if let Some(restir) = self.restir_settings() {
             restir.validate(self.path.max_depth)?;
         }
+        self.check_outputs_differ()
+    }
+
+    /// The EXR (--out) and its PNG preview (--png, default --out with a .png extension) must be
+    /// two files: with `--out image.png` the preview would overwrite the linear image.
+    fn check_outputs_differ(&self) -> Result<()> {
+        if let Some(out) = &self.out {
+            let png = self.png.clone().unwrap_or_else(|| out.with_extension("png"));
+            if &png == out {
+                bail!(
+                    "--out {}: the image is written as OpenEXR and its PNG preview would overwrite it; give --out an .exr name (the preview goes beside it) or --png another file",
+                    out.display()
+                );
+            }
+        }
         Ok(())
     }
 

@@ -176,3 +176,32 @@ fn cli_info_counts_triangles_of_identical_materials_apart() {
     };
     assert_eq!((count("left grey:"), count("right grey:"), count("lamp:")), (2, 12, 2), "{stdout}");
 }
+
+/// `--out image.png` would have the PNG preview overwrite the EXR: refused with one line, before
+/// the device opens.
+#[test]
+fn cli_out_with_a_png_name_is_refused() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
+    let out = dir.join("image.png");
+    let (code, stdout, stderr) = restir_pt(&[
+        "render",
+        "--method",
+        "pt",
+        "--spp",
+        "1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{stderr}");
+    assert!(errors[0].contains("image.png") && errors[0].contains("overwrite"), "{stderr}");
+    assert!(
+        !stdout.contains("device:") && !stderr.contains("device:"),
+        "checked before the device opens: {stderr}"
+    );
+}
