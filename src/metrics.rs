@@ -82,6 +82,18 @@ pub fn mean(values: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
+/// The standard error of the mean of `values`: the sample standard deviation (n − 1 in the
+/// denominator) over √n. None for fewer than two values, which give no estimate of spread.
+pub fn standard_error(values: &[f64]) -> Option<f64> {
+    let n = values.len();
+    if n < 2 {
+        return None;
+    }
+    let m = mean(values.iter().copied());
+    let var = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1) as f64;
+    Some((var / n as f64).sqrt())
+}
+
 /// The median (the mean of the two middle values for an even count).
 pub fn median(values: &[f64]) -> f64 {
     let mut v = values.to_vec();

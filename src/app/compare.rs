@@ -18,7 +18,7 @@ use super::render_output::status_spinner;
 use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path};
 use restir_pt::image_io::read_exr;
-use restir_pt::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, TRIMMED_SHARE};
+use restir_pt::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, standard_error, TRIMMED_SHARE};
 use restir_pt::render::{Image, RenderSettings, SceneGpu, SceneInfo, MAX_RESERVOIRS};
 use restir_pt::scene::{camera_on_path, Scene};
 
@@ -69,6 +69,9 @@ pub struct CompareRow {
     pub knob: String,
     pub gpu_ms_per_frame: f64,
     pub rel_mse: f64,
+    /// Standard error of `rel_mse`, the mean over trials (metrics::standard_error); None for
+    /// one trial.
+    pub rel_mse_stderr: Option<f64>,
     /// relMSE without the largest 0.1% of pixel errors (metrics::rel_mse_trimmed).
     pub rel_mse_trimmed: f64,
     pub mse: f64,
@@ -441,12 +444,12 @@ pub(super) fn measure(
     };
     let knob = run.fit_to_budget(renderer, knob, budget, args.frames)?;
     warn_noisy_reference(renderer, knob, run.reference_spp, label, budget);
-    let (mut times, mut rel, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], 0.0, 0.0, 0.0, 0.0, None, 0);
+    let (mut times, mut rels, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], vec![], 0.0, 0.0, 0.0, None, 0);
     let mut last = None;
     for t in 0..args.trials {
         let seq = run.sequence(renderer, args.frames, args.path.seed.wrapping_add(1 + t))?;
         times.push(seq.gpu_ms_per_frame);
-        rel += rel_mse(&seq.last_frame.mean, reference) / args.trials as f64;
+        rels.push(rel_mse(&seq.last_frame.mean, reference));
         trimmed += rel_mse_trimmed(&seq.last_frame.mean, reference, TRIMMED_SHARE) / args.trials as f64;
         abs += mse(&seq.last_frame.mean, reference) / args.trials as f64;
         energy += energy_ratio(&seq.last_frame.mean, reference) / args.trials as f64;
@@ -459,7 +462,8 @@ pub(super) fn measure(
         budget_ms: budget,
         knob: format!("{}={knob}", renderer.cost_knob_name()),
         gpu_ms_per_frame: median(&times),
-        rel_mse: rel,
+        rel_mse: rels.iter().sum::<f64>() / rels.len() as f64,
+        rel_mse_stderr: standard_error(&rels),
         rel_mse_trimmed: trimmed,
         mse: abs,
         energy_ratio: energy,
@@ -467,12 +471,13 @@ pub(super) fn measure(
         nonfinite_pixels: nonfinite,
     };
     println!(
-        "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e} (trimmed {:.4e}) | MSE {:.4e} | energy {:.4}{}",
+        "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e}{} (trimmed {:.4e}) | MSE {:.4e} | energy {:.4}{}",
         row.method,
         budget,
         row.knob,
         row.gpu_ms_per_frame,
         row.rel_mse,
+        row.rel_mse_stderr.map(|e| format!(" ± {e:.1e}")).unwrap_or_default(),
         row.rel_mse_trimmed,
         row.mse,
         row.energy_ratio,

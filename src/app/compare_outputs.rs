@@ -38,14 +38,16 @@ fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> 
     best.1
 }
 
+/// results.csv's columns; `rel_mse_stderr` is empty for one trial.
+pub(super) const CSV_HEADER: &str =
+    "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels,rel_mse_stderr";
+
 pub(super) fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
-    let mut csv = String::from(
-        "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels\n",
-    );
+    let mut csv = format!("{CSV_HEADER}\n");
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.6e},{:.5},{},{}",
+            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.6e},{:.5},{},{},{}",
             r.method,
             r.budget_ms,
             r.knob,
@@ -55,7 +57,8 @@ pub(super) fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
             r.mse,
             r.energy_ratio,
             r.failed_shift_rate.map(|f| format!("{f:.5}")).unwrap_or_default(),
-            r.nonfinite_pixels
+            r.nonfinite_pixels,
+            r.rel_mse_stderr.map(|e| format!("{e:.6e}")).unwrap_or_default()
         );
     }
     std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))
@@ -209,6 +212,7 @@ mod tests {
             knob: String::new(),
             gpu_ms_per_frame,
             rel_mse,
+            rel_mse_stderr: None,
             rel_mse_trimmed: rel_mse / 2.0,
             mse: rel_mse,
             energy_ratio: 1.0,

@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, Context as _, Result};
 
 use super::compare::{measure, note_camera_path, reservoir_cap_note, CompareArgs, CompareRow, Setup};
-use super::compare_outputs::{write_csv, write_outputs};
+use super::compare_outputs::{write_csv, write_outputs, CSV_HEADER as HEADER};
 use super::method_spec::MethodRenderer;
 use super::sweep::{
     devices, job_file, parse_optional, read_job_reports, read_job_rows, start_job, write_accounting, write_job_report, write_plan,
@@ -17,8 +17,6 @@ use super::sweep::{
 use super::{finish_device, open_device};
 use restir_pt::image_io::{read_exr, write_exr};
 use restir_pt::render::{Image, SceneGpu};
-
-const HEADER: &str = "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels";
 
 /// The jobs' labels: every method at every budget.
 fn labels(setup: &Setup, budgets: &[f64]) -> Vec<String> {
@@ -99,6 +97,7 @@ fn parse_row(fields: &[String], path: &Path) -> Result<CompareRow> {
         knob: fields[2].clone(),
         gpu_ms_per_frame: num(3)?,
         rel_mse: num(4)?,
+        rel_mse_stderr: parse_optional(&fields[10]).with_context(bad)?,
         rel_mse_trimmed: num(5)?,
         mse: num(6)?,
         energy_ratio: num(7)?,

@@ -218,10 +218,15 @@ pub fn interrupt_flag() -> Arc<AtomicBool> {
     .clone()
 }
 
-/// Creates the folder `file` goes into.
+/// Creates the folder `file` goes into, with a note on stderr when it did not exist (a mistyped
+/// folder name would otherwise leave the image somewhere unexpected without a word).
 pub fn create_parent(file: &Path) -> Result<()> {
-    match file.parent().filter(|d| !d.as_os_str().is_empty()) {
-        Some(dir) => std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display())),
+    match file.parent().filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
+            eprintln!("note: created the folder {}", dir.display());
+            Ok(())
+        }
         None => Ok(()),
     }
 }

@@ -5,19 +5,17 @@
 //! (textured and not) materials.
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::gpu_types::{FrameParams, Material, Triangle, NO_EMITTER};
+use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::bvh::{bvh_traverse, intersect_triangle, trace_pair, PairRay, NO_HIT};
 use restir_pt::scene::{Camera, Scene, SceneParts};
-use restir_pt::shader_interface::SurfaceBinding;
 use restir_pt::shading::alpha::{alpha_hash, alpha_keeps, AlphaScene};
 use restir_pt::shading::surface::TriangleSurface;
 use restir_pt::shading::texture::{
     material_alpha, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE, TEXTURE_WRAP_REPEAT,
 };
-use restir_pt::vk::{Binding, BindingSlot, Buffer, BufferUsage, Kernel};
 
-use crate::common::{assert_clean, close, gpu, TestRng, NAN_FILL};
+use crate::common::{assert_clean, close, gpu, run_surface_set0_oracle, TestRng};
 
 const RAYS: usize = 20_000;
 /// Alpha decisions closer than this to their threshold may differ between llvmpipe's and
@@ -134,31 +132,7 @@ fn run_alpha_oracle(scene: &Scene, inputs: &[Vec4]) -> Vec<Vec4> {
         scene_gpu.defines().contains(&("SCENE_ALPHA", "1")),
         "the scene must compile alpha testing in"
     );
-    let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
-    let params = Buffer::new(&ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
-    params.write(&[FrameParams::default()]).unwrap();
-    let items = inputs.len() / 3;
-    let input = Buffer::from_slice(&ctx, "inputs", inputs).unwrap();
-    let output = Buffer::new(&ctx, "outputs", (items * 4 * 16) as u64, BufferUsage::Storage).unwrap();
-    output.fill(NAN_FILL).unwrap();
-    let surface_slot = |b: SurfaceBinding| b.slot_at(0, 5, Binding::Storage);
-    let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend(
-        SurfaceBinding::ALL
-            .iter()
-            .zip(&surface.buffers)
-            .map(|(&b, buffer)| surface_slot(b).to(buffer)),
-    );
-    buffers.extend([
-        BindingSlot::storage(9, "Inputs").to(&input),
-        BindingSlot::storage(10, "Outputs").to(&output),
-    ]);
-    let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
-    let kernel = Kernel::new(&ctx, "oracle/alpha_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
-    kernel.bind(&buffers).unwrap();
-    kernel.run_1d(items as u32, 64, bytemuck::bytes_of(&(items as u32))).unwrap();
-    let out = bytemuck::cast_slice(&output.read::<u32>(items * 16).unwrap()).to_vec();
-    drop(kernel);
+    let out = run_surface_set0_oracle(&ctx, &scene_gpu, "oracle/alpha_oracle.comp", inputs, inputs.len() / 3, 4);
     assert_clean(&ctx);
     out
 }

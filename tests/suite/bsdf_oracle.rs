@@ -6,7 +6,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::*;
 
-use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_bsdf_oracle, TestRng};
 
 /// Relative agreement of values; GGX at small alpha and grazing angles amplifies ulp differences.
 const TOL: f32 = 1e-3;
@@ -99,17 +99,7 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
         ]);
         inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
     }
-    let out: Vec<Vec4> = run_oracle(
-        &ctx,
-        "oracle/bsdf_oracle.comp",
-        &[],
-        &[
-            ("Materials", bytemuck::cast_slice(&materials)),
-            ("Inputs", bytemuck::cast_slice(&inputs)),
-        ],
-        n_items * 12,
-        n_items as u32,
-    );
+    let out = run_bsdf_oracle(&ctx, &materials, &inputs);
     let mut excluded = 0;
     let mut sampled = 0;
     for i in 0..n_items {

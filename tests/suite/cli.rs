@@ -18,6 +18,15 @@ pub(crate) fn restir_pt(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// `restir-pt render` of the default scene with the path tracer at `width`×`height` and `spp`
+/// samples per pixel, then `extra` arguments.
+pub(crate) fn render_pt(width: u32, height: u32, spp: u32, extra: &[&str]) -> (i32, String, String) {
+    let (width, height, spp) = (width.to_string(), height.to_string(), spp.to_string());
+    let mut args = vec!["render", "--width", &width, "--height", &height, "--method", "pt", "--spp", &spp];
+    args.extend_from_slice(extra);
+    restir_pt(&args)
+}
+
 /// Exit code 1 and exactly one `error:` line that mentions every `needle`.
 pub(crate) fn assert_clean_failure(args: &[&str], needles: &[&str]) {
     let (code, _, stderr) = restir_pt(args);
@@ -34,24 +43,20 @@ pub(crate) fn assert_clean_failure(args: &[&str], needles: &[&str]) {
 fn cli_render_writes_images_summary_and_report() {
     let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
     let (exr, png, report) = (dir.join("c.exr"), dir.join("c.png"), dir.join("r.json"));
-    let (code, stdout, stderr) = restir_pt(&[
-        "render",
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--method",
-        "pt",
-        "--spp",
-        "4",
-        "--validate",
-        "--out",
-        exr.to_str().unwrap(),
-        "--png",
-        png.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let (code, stdout, stderr) = render_pt(
+        32,
+        24,
+        4,
+        &[
+            "--validate",
+            "--out",
+            exr.to_str().unwrap(),
+            "--png",
+            png.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ],
+    );
     assert_eq!(code, 0, "{stderr}");
     assert!(stderr.contains("device: "), "the chosen device is printed: {stderr}");
     assert!(
@@ -131,21 +136,7 @@ fn cli_bad_input_fails_before_the_device_opens() {
 fn cli_max_depth_one_shows_only_emitters() {
     let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
     let exr = dir.join("d1.exr");
-    let (code, _, stderr) = restir_pt(&[
-        "render",
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--method",
-        "pt",
-        "--spp",
-        "2",
-        "--max-depth",
-        "1",
-        "--out",
-        exr.to_str().unwrap(),
-    ]);
+    let (code, _, stderr) = render_pt(32, 32, 2, &["--max-depth", "1", "--out", exr.to_str().unwrap()]);
     assert_eq!(code, 0, "{stderr}");
     let (_, _, pixels) = restir_pt::image_io::read_exr(&exr).unwrap();
     let lit = pixels.iter().filter(|p| p.max_element() > 0.0).count();
@@ -163,26 +154,22 @@ fn cli_max_depth_one_shows_only_emitters() {
 fn cli_frames_render_along_the_camera_path() {
     let dir = temp_file("placeholder", b"").parent().unwrap().join("frames");
     let last = dir.join("last.exr");
-    let (code, stdout, stderr) = restir_pt(&[
-        "render",
-        "--frames",
-        "3",
-        "--camera",
-        "2",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--method",
-        "pt",
-        "--spp",
-        "2",
-        "--validate",
-        "--out-dir",
-        dir.to_str().unwrap(),
-        "--out",
-        last.to_str().unwrap(),
-    ]);
+    let (code, stdout, stderr) = render_pt(
+        16,
+        16,
+        2,
+        &[
+            "--frames",
+            "3",
+            "--camera",
+            "2",
+            "--validate",
+            "--out-dir",
+            dir.to_str().unwrap(),
+            "--out",
+            last.to_str().unwrap(),
+        ],
+    );
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(stdout.lines().filter(|l| l.starts_with("frame ")).count(), 3, "{stdout}");
     for k in 0..3 {
@@ -191,21 +178,7 @@ fn cli_frames_render_along_the_camera_path() {
     // The last frame is also the --out image.
     assert_eq!(std::fs::read(dir.join("frame_0002.exr")).unwrap(), std::fs::read(&last).unwrap());
     // More frames than the scene has cameras walk its camera path back and forth.
-    let (code, stdout, stderr) = restir_pt(&[
-        "render",
-        "--frames",
-        "16",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--method",
-        "pt",
-        "--spp",
-        "1",
-        "--out",
-        last.to_str().unwrap(),
-    ]);
+    let (code, stdout, stderr) = render_pt(8, 8, 1, &["--frames", "16", "--out", last.to_str().unwrap()]);
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(stdout.lines().filter(|l| l.starts_with("frame ")).count(), 16, "{stdout}");
 }
@@ -214,21 +187,7 @@ fn cli_frames_render_along_the_camera_path() {
 fn cli_device_by_index_is_chosen_and_printed() {
     let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
     let out = dir.join("dev.exr");
-    let (code, _, stderr) = restir_pt(&[
-        "render",
-        "--device",
-        "0",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--method",
-        "pt",
-        "--spp",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (code, _, stderr) = render_pt(8, 8, 1, &["--device", "0", "--out", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{stderr}");
     assert!(stderr.lines().any(|l| l.starts_with("device: ")), "{stderr}");
 }

@@ -7,7 +7,7 @@ use glam::Vec3;
 use restir_pt::image_io::read_exr;
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
-use crate::cli::{assert_clean_failure, restir_pt};
+use crate::cli::{assert_clean_failure, render_pt, restir_pt};
 use crate::common::temp_file;
 
 fn s(p: &std::path::Path) -> &str {
@@ -116,21 +116,7 @@ fn cli_negative_values_are_values() {
         &["compare", "scenes/cornell.gltf", "--reference", "x.exr", "--budgets-ms", "-5"],
         &["--budgets-ms -5"],
     );
-    let (code, _, stderr) = restir_pt(&[
-        "render",
-        "--method",
-        "pt",
-        "--spp",
-        "1",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--exposure",
-        "-2",
-        "--out",
-        s(&out),
-    ]);
+    let (code, _, stderr) = render_pt(8, 8, 1, &["--exposure", "-2", "--out", s(&out)]);
     assert_eq!(code, 0, "{stderr}");
 }
 
@@ -183,19 +169,7 @@ fn cli_info_counts_triangles_of_identical_materials_apart() {
 fn cli_out_with_a_png_name_is_refused() {
     let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
     let out = dir.join("image.png");
-    let (code, stdout, stderr) = restir_pt(&[
-        "render",
-        "--method",
-        "pt",
-        "--spp",
-        "1",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--out",
-        s(&out),
-    ]);
+    let (code, stdout, stderr) = render_pt(8, 8, 1, &["--out", s(&out)]);
     assert_eq!(code, 1, "{stderr}");
     let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
     assert_eq!(errors.len(), 1, "{stderr}");
@@ -204,4 +178,17 @@ fn cli_out_with_a_png_name_is_refused() {
         !stdout.contains("device:") && !stderr.contains("device:"),
         "checked before the device opens: {stderr}"
     );
+}
+
+/// `--out` into a folder that does not exist creates it and says so on stderr.
+#[test]
+fn cli_out_into_a_missing_folder_creates_it_with_a_note() {
+    let dir = temp_file("placeholder", b"").parent().unwrap().join("missing-folder");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("nested").join("image.exr");
+    let (code, _, stderr) = render_pt(8, 8, 1, &["--out", s(&out)]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(out.exists(), "{stderr}");
+    let folder = out.parent().unwrap().display().to_string();
+    assert!(stderr.contains(&format!("note: created the folder {folder}")), "{stderr}");
 }

@@ -1,7 +1,7 @@
 //! The restir-pt binary's measurement commands (reference, profile, compare) and the check of
 //! every written image for non-finite pixels.
 
-use crate::cli::{assert_clean_failure, restir_pt};
+use crate::cli::{assert_clean_failure, render_pt, restir_pt};
 use crate::common::temp_file;
 
 /// `restir-pt reference` of cornell at 16x16 into `dir/ref.exr`.
@@ -67,6 +67,8 @@ fn cli_compare_writes_results_charts_and_strip() {
         &budgets.join(","),
         "--frames",
         "3",
+        "--trials",
+        "2",
         "--out-dir",
         dir.to_str().unwrap(),
     ]);
@@ -81,6 +83,9 @@ fn cli_compare_writes_results_charts_and_strip() {
         assert!(rel_mse.is_finite() && rel_mse > 0.0 && gpu_ms > 0.0, "{row:?}");
         assert!(trimmed > 0.0 && trimmed <= rel_mse, "trimmed relMSE: {row:?}");
         assert_eq!(row[9], "0", "non-finite pixels: {row:?}");
+        // Two trials of different seeds give a spread.
+        let stderr_of_mean: f64 = row[10].parse().unwrap();
+        assert!(stderr_of_mean > 0.0 && stderr_of_mean < rel_mse, "relMSE standard error: {row:?}");
     }
     // A larger budget buys the path tracer more samples per frame.
     let spp = |r: &Vec<&str>| r[2].trim_start_matches("spp=").parse::<u32>().unwrap();
@@ -190,21 +195,17 @@ fn cli_nonfinite_pixels_fail_the_render_unless_allowed() {
 fn cli_render_reports_zero_nonfinite_counts_on_a_clean_scene() {
     let dir = temp_file("placeholder", b"").parent().unwrap().to_path_buf();
     let report = dir.join("clean.json");
-    let (code, stdout, stderr) = restir_pt(&[
-        "render",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--method",
-        "pt",
-        "--spp",
-        "4",
-        "--out",
-        dir.join("clean.exr").to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let (code, stdout, stderr) = render_pt(
+        16,
+        16,
+        4,
+        &[
+            "--out",
+            dir.join("clean.exr").to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ],
+    );
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("non-finite pixels 0, weights 0"), "{stdout}");
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();

@@ -86,6 +86,63 @@ pub fn run_scene_oracle<T: bytemuck::Pod>(
     run_built_oracle(ctx, build, &scene_gpu.buffers(frame), inputs, output_words, count)
 }
 
+/// Runs oracle/bsdf_oracle.comp (`bsdf_eval_pdf` and `bsdf_sample`): `inputs` holds 5 vec4s per
+/// material (geometric normal, shading normal, wo, wi, u); 3 vec4s come back per material
+/// ((f, pdf), (sampled wi, pdf), (weight, lobe bits)).
+pub fn run_bsdf_oracle(ctx: &Arc<Context>, materials: &[restir_pt::gpu_types::Material], inputs: &[glam::Vec4]) -> Vec<glam::Vec4> {
+    assert_eq!(inputs.len(), 5 * materials.len(), "5 input rows per material");
+    run_oracle(
+        ctx,
+        "oracle/bsdf_oracle.comp",
+        &[],
+        &[
+            ("Materials", bytemuck::cast_slice(materials)),
+            ("Inputs", bytemuck::cast_slice(inputs)),
+        ],
+        materials.len() * 12,
+        materials.len() as u32,
+    )
+}
+
+/// Runs an oracle kernel that binds everything in set 0: the scene at 0-4 (default frame
+/// parameters), its surface attributes and textures at 5-8 (SURFACE_SET 0, SURFACE_BINDING 5 in
+/// the kernel), `Inputs` at 9 and `Outputs` at 10; the push constant is the item count.
+/// `rows_per_item` vec4s come back per item.
+pub fn run_surface_set0_oracle(
+    ctx: &Arc<Context>,
+    scene_gpu: &SceneGpu,
+    kernel: &str,
+    inputs: &[glam::Vec4],
+    items: usize,
+    rows_per_item: usize,
+) -> Vec<glam::Vec4> {
+    use restir_pt::gpu_types::FrameParams;
+    use restir_pt::shader_interface::SurfaceBinding;
+    use restir_pt::vk::{Binding, BufferUsage};
+    let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
+    let params = Buffer::new(ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
+    params.write(&[FrameParams::default()]).unwrap();
+    let input = Buffer::from_slice(ctx, "inputs", inputs).unwrap();
+    let output = Buffer::new(ctx, "outputs", (items * rows_per_item * 16) as u64, BufferUsage::Storage).unwrap();
+    output.fill(NAN_FILL).unwrap();
+    let mut buffers = scene_gpu.buffers(&params);
+    buffers.extend(
+        SurfaceBinding::ALL
+            .iter()
+            .zip(&surface.buffers)
+            .map(|(&b, buffer)| b.slot_at(0, 5, Binding::Storage).to(buffer)),
+    );
+    buffers.extend([
+        BindingSlot::storage(9, "Inputs").to(&input),
+        BindingSlot::storage(10, "Outputs").to(&output),
+    ]);
+    let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
+    let k = Kernel::new(ctx, kernel, &scene_gpu.defines(), &layout, 4).unwrap();
+    k.bind(&buffers).unwrap();
+    k.run_1d(items as u32, 64, bytemuck::bytes_of(&(items as u32))).unwrap();
+    bytemuck::cast_slice(&output.read::<u32>(items * rows_per_item * 4).unwrap()).to_vec()
+}
+
 /// Runs the oracle kernel `build` makes from the layout of `leading`, `inputs` and `Outputs`.
 fn run_built_oracle<T: bytemuck::Pod>(
     ctx: &Arc<Context>,

@@ -8,7 +8,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::{bsdf_sample, index_matched, DELTA_ALPHA, LOBE_TRANSMISSION};
 
-use crate::common::{assert_clean, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
 
 pub const IORS: [f32; 9] = [1.0, 1.0 + 1e-6, 1.0 - 1e-6, 1.0001, 1.01, 1.33, 1.5, 2.4, 1.0 / 1.5];
 pub const ROUGHNESSES: [f32; 5] = [0.0, 0.01, 0.1, 0.5, 1.0];
@@ -121,18 +121,7 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
             inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
         }
     }
-    let items = materials.len();
-    let out: Vec<Vec4> = run_oracle(
-        &ctx,
-        "oracle/bsdf_oracle.comp",
-        &[],
-        &[
-            ("Materials", bytemuck::cast_slice(&materials)),
-            ("Inputs", bytemuck::cast_slice(&inputs)),
-        ],
-        items * 12,
-        items as u32,
-    );
+    let out = run_bsdf_oracle(&ctx, &materials, &inputs);
     let mut lowest = (f64::MAX, String::new());
     for (c, case) in cases.iter().enumerate() {
         let what = format!("IOR {}, roughness {}, cos_o {}", case.ior, case.roughness, case.wo.z);

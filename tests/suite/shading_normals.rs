@@ -9,7 +9,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::{bsdf_eval_pdf, sides_agree};
 
-use crate::common::{assert_clean, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
 
 /// The tilt the shading normal encodes: 25° about the x axis from the geometric normal +z.
 fn tilted_normal() -> Vec3 {
@@ -47,17 +47,7 @@ fn shading_normal_tilted_plane_matches_closed_form_glsl_and_rust() {
         inputs.extend([Vec4::Z, ns.extend(0.0), r.unit_vector().extend(0.0), r.unit_vector().extend(0.0)]);
         inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
     }
-    let out: Vec<Vec4> = run_oracle(
-        &ctx,
-        "oracle/bsdf_oracle.comp",
-        &[],
-        &[
-            ("Materials", bytemuck::cast_slice(&materials)),
-            ("Inputs", bytemuck::cast_slice(&inputs)),
-        ],
-        materials.len() * 12,
-        materials.len() as u32,
-    );
+    let out = run_bsdf_oracle(&ctx, &materials, &inputs);
     let (mut lit, mut rejected) = (0, 0);
     for (i, m) in materials.iter().enumerate() {
         let (wo, wi) = (inputs[5 * i + 2].truncate(), inputs[5 * i + 3].truncate());

@@ -10,7 +10,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, specular_layer_fresnel, DELTA_ALPHA, LOBE_NONE};
 
-use crate::common::{assert_clean, gpu, run_oracle, TestRng};
+use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
 use crate::sampling_statistics::chi_square_critical_1pct;
 
 fn plastic(roughness: f32, ior: f32, specular: f32, specular_color: Vec3) -> Material {
@@ -78,18 +78,7 @@ fn specular_layer_furnace_never_gains_energy_glsl_and_rust() {
             }
         }
     }
-    let items = materials.len();
-    let out: Vec<Vec4> = run_oracle(
-        &ctx,
-        "oracle/bsdf_oracle.comp",
-        &[],
-        &[
-            ("Materials", bytemuck::cast_slice(&materials)),
-            ("Inputs", bytemuck::cast_slice(&inputs)),
-        ],
-        items * 12,
-        items as u32,
-    );
+    let out = run_bsdf_oracle(&ctx, &materials, &inputs);
     let mut lowest = vec![(f32::MAX, String::new()); ROUGHNESSES.len()];
     for (c, (m, wo)) in cases.iter().enumerate() {
         let what = format!(
@@ -209,7 +198,9 @@ fn specular_layer_sampling_chi_square() {
 }
 
 /// A rough non-metal's BSDF and image depend on its roughness; with `specularFactor` 0 (pure
-/// Lambertian, the model before the layer) neither does, bit for bit.
+/// Lambertian, the model before the layer) neither does: the BSDF bit for bit, the image within
+/// a relative 1e-5 per pixel (two renders once differed by one ulp on a loaded machine; the
+/// highlight's dependence on roughness is a factor of 3 and more).
 #[test]
 fn specular_layer_roughness_changes_the_bsdf_and_the_image() {
     let wo = Vec3::new(0.6, 0.0, 0.8);
@@ -239,7 +230,15 @@ fn specular_layer_roughness_changes_the_bsdf_and_the_image() {
     assert!(sharp > 3.0 * broad, "highlight peak at roughness 0.15: {sharp}, at 0.9: {broad}");
     let (_, lambert_a) = peak(0.15, 0.0);
     let (_, lambert_b) = peak(0.9, 0.0);
-    assert_eq!(lambert_a, lambert_b, "a Lambertian plane's image must not depend on roughness");
+    let worst = lambert_a
+        .iter()
+        .zip(&lambert_b)
+        .map(|(a, b)| (a - b).abs() / a.abs().max(b.abs()).max(1e-6))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst <= 1e-5,
+        "a Lambertian plane's image must not depend on roughness: worst relative difference {worst}"
+    );
     assert_clean(&ctx);
 }
 

@@ -3,13 +3,13 @@
 //! the unit test in src/app/compare_outputs.rs.
 
 use glam::Vec3;
-use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed};
+use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed, standard_error};
 
 use crate::cli::restir_pt;
 use crate::common::{repo_path, temp_file};
 
 #[test]
-fn metrics_rel_mse_energy_and_flicker_match_hand_values() {
+fn metrics_rel_mse_energy_flicker_and_standard_error_match_hand_values() {
     let reference = [Vec3::splat(1.0), Vec3::ZERO];
     let image = [Vec3::splat(2.0), Vec3::splat(0.1)];
     // (2-1)^2/(1+0.01) per channel, 0.01/0.01 per channel, averaged over 6 channels.
@@ -27,6 +27,9 @@ fn metrics_rel_mse_energy_and_flicker_match_hand_values() {
     assert!((rel_mse(&noisy, &black) - (999.0 * 0.01 + 100.0) / 1000.0).abs() < 1e-6);
     assert!((rel_mse_trimmed(&noisy, &black, 1e-3) - 0.01).abs() < 1e-6);
     assert!((rel_mse_trimmed(&noisy, &black, 0.0) - rel_mse(&noisy, &black)).abs() < 1e-9);
+    // compare's ± over trials: mean 2.5, sample variance 5/3, so sqrt(5/3 / 4).
+    assert!((standard_error(&[1.0, 2.0, 3.0, 4.0]).unwrap() - (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+    assert_eq!(standard_error(&[7.0]), None);
 }
 
 /// The path tracer and ReSTIR PT (hybrid) on cornell, 64x64, 16 frames with a static and a

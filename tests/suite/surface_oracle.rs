@@ -5,18 +5,16 @@
 //! address mode, bilinear and nearest, sRGB and linear, KHR_texture_transform rows).
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::gpu_types::{FrameParams, Material, Triangle, NO_EMITTER};
+use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
-use restir_pt::shader_interface::SurfaceBinding;
 use restir_pt::shading::surface::{surface_at, triangle_bary, SurfaceHit, TriangleSurface};
 use restir_pt::shading::texture::{
     normal_mapped, texture_coordinates, texture_lookup, textured_material, MaterialTextures, SceneTextures, TextureHeader, TextureSlot,
     NO_TEXTURE, TEXTURE_NEAREST,
 };
-use restir_pt::vk::{Binding, BindingSlot, Buffer, BufferUsage, Kernel};
 
-use crate::common::{assert_clean, assert_vec3_close, close, gpu, TestRng, NAN_FILL};
+use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_surface_set0_oracle, TestRng};
 
 const ITEMS: usize = 20_000;
 const TEXTURES: usize = 9;
@@ -203,32 +201,7 @@ fn random_hits(scene: &Scene) -> Vec<Vec4> {
 fn run_surface_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene_gpu: &SceneGpu, inputs: &[Vec4]) -> Vec<Vec4> {
     let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
     assert_eq!(surface.buffers.len(), 4, "attributes and three texture buffers");
-    let params = Buffer::new(ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
-    params.write(&[FrameParams::default()]).unwrap();
-    let input = Buffer::from_slice(ctx, "inputs", inputs).unwrap();
-    let output = Buffer::new(ctx, "outputs", (ITEMS * ROWS * 16) as u64, BufferUsage::Storage).unwrap();
-    output.fill(NAN_FILL).unwrap();
-    // The oracle binds everything in set 0: the surface family at 5-8 (SURFACE_SET 0,
-    // SURFACE_BINDING 5 in surface_oracle.comp), then the inputs and outputs.
-    let surface_slot = |b: SurfaceBinding| b.slot_at(0, 5, Binding::Storage);
-    let mut buffers = scene_gpu.buffers(&params);
-    buffers.extend(
-        SurfaceBinding::ALL
-            .iter()
-            .zip(&surface.buffers)
-            .map(|(&b, buffer)| surface_slot(b).to(buffer)),
-    );
-    buffers.extend([
-        BindingSlot::storage(9, "Inputs").to(&input),
-        BindingSlot::storage(10, "Outputs").to(&output),
-    ]);
-    let mut layout = scene_gpu.bindings();
-    layout.extend(SurfaceBinding::ALL.iter().map(|&b| surface_slot(b)));
-    layout.extend([BindingSlot::storage(9, "Inputs"), BindingSlot::storage(10, "Outputs")]);
-    let kernel = Kernel::new(ctx, "oracle/surface_oracle.comp", &scene_gpu.defines(), &layout, 4).unwrap();
-    kernel.bind(&buffers).unwrap();
-    kernel.run_1d(ITEMS as u32, 64, bytemuck::bytes_of(&(ITEMS as u32))).unwrap();
-    bytemuck::cast_slice(&output.read::<u32>(ITEMS * ROWS * 4).unwrap()).to_vec()
+    run_surface_set0_oracle(ctx, scene_gpu, "oracle/surface_oracle.comp", inputs, ITEMS, ROWS)
 }
 
 /// Asserts item `i`'s GLSL outputs `g` against the Rust twins; false when the item was skipped
