@@ -48,7 +48,7 @@ motion() {
     local ref="$WORK/$scene-128-camera$camera-ref.exr"
     reference "$scene" "$camera" 128 "$ref"
     "$RESTIR_PT" compare "scenes/$scene.gltf" --reference "$ref" --frames "$frames" --camera-path \
-        --methods pt,restir,restir@s0 --trials "${TRIALS:-4}" --out-dir "$out"
+        --methods pt,restir,restir@s0 --trials "${TRIALS:-8}" --out-dir "$out"
 }
 
 items=("$@")

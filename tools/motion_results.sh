@@ -2,7 +2,7 @@
 # ReSTIR PT in motion against the path tracer at equal GPU time per frame (issue 17's bar):
 # runs tools/make_results.sh's moving-camera items (veach-door and cornell-glossy, 128×128, the
 # camera on the scene's path, the last of 8 and of 16 frames against a reference of its own
-# pose; methods pt, restir (defaults) and restir@s0 (spatial reuse off); 4 trials per point),
+# pose; methods pt, restir (defaults) and restir@s0 (spatial reuse off); 8 trials per point),
 # then writes docs/results/motion-summary.md: every ReSTIR PT row against the path tracer at the
 # same ms per frame.
 #
@@ -12,15 +12,16 @@
 # by t. "vs @s0" is the same for spatial reuse on against off: relMSE × time of restir@s0 at t
 # over the row's.
 #
-# Usage: tools/motion_results.sh [ITEM...]   (default: the README's two 8-frame items; about half an hour on a
-#   quiet 2-core machine). Environment as tools/make_results.sh (RESTIR_PT, DEST, WORK, TRIALS);
-#   SUMMARY_ONLY=1 rewrites the summary from the results already in DEST.
+# Usage: tools/motion_results.sh [ITEM...]   (default: the README's four items, 8 and 16 frames
+#   of each scene; about 20 minutes on a quiet 2-core machine once the references exist).
+#   Environment as tools/make_results.sh (RESTIR_PT, DEST, WORK, TRIALS); SUMMARY_ONLY=1
+#   rewrites the summary from the results already in DEST.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 DEST=${DEST:-docs/results}
 items=("$@")
-[[ ${#items[@]} -gt 0 ]] || items=(motion-veach-door-8 motion-cornell-glossy-8)
+[[ ${#items[@]} -gt 0 ]] || items=(motion-veach-door-8 motion-cornell-glossy-8 motion-veach-door-16 motion-cornell-glossy-16)
 [[ -n ${SUMMARY_ONLY:-} ]] || DEST=$DEST tools/make_results.sh "${items[@]}"
 
 python3 - "$DEST" "${items[@]}" <<'EOF'
