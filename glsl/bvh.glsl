@@ -11,9 +11,6 @@
 #ifndef SCENE_ALPHA
 #define SCENE_ALPHA 0
 #endif
-#if SCENE_ALPHA
-#include "alpha.glsl"
-#endif
 
 const uint NO_HIT = 0xffffffffu;
 
@@ -59,8 +56,11 @@ vec3 safe_inverse(vec3 d) {
     return vec3(d.x != 0.0 ? 1.0 / d.x : big, d.y != 0.0 ? 1.0 / d.y : big, d.z != 0.0 ? 1.0 / d.z : big);
 }
 
+#if SCENE_ALPHA
+#include "alpha_trace.glsl"
+#else
 // Closest hit when any_hit is false; the first hit found otherwise (shadow rays). With
-// SCENE_ALPHA, hits that alpha_keeps rejects do not count. Stackless: the
+// SCENE_ALPHA, hits that alpha_keeps rejects do not count (alpha_trace.glsl). Stackless: the
 // uniform control flow suits SIMD CPUs (lavapipe) and keeps register pressure low on GPUs.
 Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     Hit hit;
@@ -94,11 +94,7 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
             count_subgroup(COUNTER_TRIANGLE_ITERATIONS);
             float t;
             vec2 bary;
-            if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)
-#if SCENE_ALPHA
-                && alpha_keeps(i, bary, o, d)
-#endif
-            ) {
+            if (intersect_triangle(o, d, triangles[i], hit.t, t, bary)) {
                 hit.t = t;
                 hit.triangle = i;
                 hit.bary = bary;
@@ -111,6 +107,8 @@ Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     note_loop_exit(node < end);
     return hit;
 }
+
+#endif
 
 Hit trace_closest(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, false); }
 bool trace_occluded(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, true).triangle != NO_HIT; }

@@ -22,7 +22,9 @@ struct PairRay {
     float tmax;
 };
 
-#if SCENE_BRUTE_FORCE
+#if SCENE_ALPHA
+#include "alpha_trace_pair.glsl"
+#elif SCENE_BRUTE_FORCE
 void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded) {
     hit = Hit(closest.tmax, NO_HIT, vec2(0.0));
     occluded = false;
@@ -36,18 +38,10 @@ void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded)
         Triangle tri = triangles[i];
         float t;
         vec2 bary;
-        if (intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)
-#if SCENE_ALPHA
-            && alpha_keeps(i, bary, closest.origin, closest.dir)
-#endif
-        ) {
+        if (intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)) {
             hit = Hit(t, i, bary);
         }
-        occluded = (intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary)
-#if SCENE_ALPHA
-            && alpha_keeps(i, bary, shadow.origin, shadow.dir)
-#endif
-            ) || occluded;
+        occluded = intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary) || occluded;
     }
     note_loop_exit(i < triangle_count);
 }
@@ -89,18 +83,10 @@ void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded)
             Triangle tri = triangles[i];
             float t;
             vec2 bary;
-            if (enter_c && intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)
-#if SCENE_ALPHA
-                && alpha_keeps(i, bary, closest.origin, closest.dir)
-#endif
-            ) {
+            if (enter_c && intersect_triangle(closest.origin, closest.dir, tri, hit.t, t, bary)) {
                 hit = Hit(t, i, bary);
             }
-            occluded = (enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary)
-#if SCENE_ALPHA
-                && alpha_keeps(i, bary, shadow.origin, shadow.dir)
-#endif
-                ) || occluded;
+            occluded = (enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax, t, bary)) || occluded;
         }
         note_loop_exit(i < last);
         // An occluded shadow ray is done, and so is the lane if it has no closest ray.

@@ -25,7 +25,7 @@ struct Triangle {
     vec3 e1;
     uint emitter;       // index into the emitter table, NO_EMITTER if not emissive
     vec3 e2;
-    uint pad;
+    uint alpha_tested;  // 1 if the material's alphaMode is MASK or BLEND (alpha.glsl), else 0
 };
 const uint NO_EMITTER = 0xffffffffu;
 

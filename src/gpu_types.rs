@@ -31,7 +31,10 @@ pub struct Triangle {
     pub e1: [f32; 3],
     pub emitter: u32,
     pub e2: [f32; 3],
-    pub pad: u32,
+    /// 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0: set by
+    /// [`crate::scene::Scene::build`], so that traversal reaches the material and its texture
+    /// only for such triangles (glsl/alpha.glsl, [`crate::shading::alpha::alpha_keeps`]).
+    pub alpha_tested: u32,
 }
 
 #[repr(C)]

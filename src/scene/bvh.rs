@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::gpu_types::{BvhNode, Triangle, LEAF_COUNT_BITS, LEAF_COUNT_MASK};
-use crate::shading::alpha::{alpha_keeps, AlphaScene};
+use crate::shading::alpha::AlphaScene;
 use crate::shading::ray_offset::offset_ray_origin;
 
 pub const NO_HIT: u32 = u32::MAX;
@@ -234,7 +234,8 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
 }
 
 /// Twin of GLSL `bvh_traverse`: closest hit, or the first hit found when `any_hit`. With
-/// `alpha` (the kernels' `SCENE_ALPHA`), hits that `alpha_keeps` rejects do not count.
+/// `alpha` (the kernels' `SCENE_ALPHA`), hits that `alpha_keeps` rejects do not count
+/// ([`crate::scene::alpha_trace::bvh_traverse`]).
 pub fn bvh_traverse(
     nodes: &[BvhNode],
     triangles: &[Triangle],
@@ -244,7 +245,9 @@ pub fn bvh_traverse(
     tmax: f32,
     any_hit: bool,
 ) -> Hit {
-    let keeps = |i: u32, bary: Vec2| alpha.is_none_or(|a| alpha_keeps(a, triangles, i, bary, o, d));
+    if let Some(alpha) = alpha {
+        return crate::scene::alpha_trace::bvh_traverse(nodes, triangles, alpha, o, d, tmax, any_hit);
+    }
     let mut hit = Hit {
         t: tmax,
         triangle: NO_HIT,
@@ -265,7 +268,7 @@ pub fn bvh_traverse(
             continue;
         }
         for i in first..first + count {
-            if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t).filter(|&(_, b)| keeps(i, b)) {
+            if let Some((t, bary)) = intersect_triangle(o, d, &triangles[i as usize], hit.t) {
                 hit = Hit { t, triangle: i, bary };
                 if any_hit {
                     return hit;
@@ -320,7 +323,7 @@ pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 64;
 /// every triangle in index order, the closest hit being the first of equal distances). The BVH
 /// form tests each ray against the same triangles in the same order as `bvh_traverse`, so its
 /// results equal `trace_closest` and `trace_occluded` bit for bit. With `alpha` (`SCENE_ALPHA`)
-/// each ray skips the hits `alpha_keeps` rejects for it.
+/// each ray skips the hits `alpha_keeps` rejects for it ([`crate::scene::alpha_trace::trace_pair`]).
 pub fn trace_pair(
     nodes: &[BvhNode],
     triangles: &[Triangle],
@@ -329,7 +332,9 @@ pub fn trace_pair(
     closest: PairRay,
     shadow: PairRay,
 ) -> (Hit, bool) {
-    let keeps = |i: usize, bary: Vec2, ray: &PairRay| alpha.is_none_or(|a| alpha_keeps(a, triangles, i as u32, bary, ray.origin, ray.dir));
+    if let Some(alpha) = alpha {
+        return crate::scene::alpha_trace::trace_pair(nodes, triangles, alpha, brute_force, closest, shadow);
+    }
     let mut hit = Hit {
         t: closest.tmax,
         triangle: NO_HIT,
@@ -339,7 +344,7 @@ pub fn trace_pair(
     let test = |i: usize, enter_c: bool, enter_s: bool, hit: &mut Hit, occluded: &mut bool| {
         let tri = &triangles[i];
         if enter_c {
-            if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, hit.t).filter(|&(_, b)| keeps(i, b, &closest)) {
+            if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, hit.t) {
                 *hit = Hit {
                     t,
                     triangle: i as u32,
@@ -347,7 +352,7 @@ pub fn trace_pair(
                 };
             }
         }
-        *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some_and(|(_, b)| keeps(i, b, &shadow));
+        *occluded |= enter_s && intersect_triangle(shadow.origin, shadow.dir, tri, shadow.tmax).is_some();
     };
     if brute_force {
         for i in 0..triangles.len() {

@@ -232,7 +232,7 @@ impl Loader<'_> {
             e1: e1.into(),
             emitter: NO_EMITTER,
             e2: e2.into(),
-            pad: 0,
+            alpha_tested: 0,
         });
         Ok(())
     }

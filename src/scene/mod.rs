@@ -1,6 +1,7 @@
 //! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
 
 pub mod bundled_scenes;
+pub mod alpha_trace;
 pub mod bvh;
 mod camera;
 pub mod environment;
@@ -31,7 +32,7 @@ use crate::scene::bvh::Bvh;
 use crate::scene::environment::EnvironmentMap;
 use crate::shading::lights::build_alias_table;
 use crate::shading::surface::TriangleSurface;
-use crate::shading::texture::SceneTextures;
+use crate::shading::texture::{SceneTextures, ALPHA_OPAQUE};
 
 /// Probability that NEE samples the environment when the scene also has emissive triangles.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
@@ -122,6 +123,8 @@ impl Scene {
             let sides = if m.is_double_sided() { 2.0 } else { 1.0 };
             let power = luminance(Vec3::from(m.emission)) * tri.area() * std::f32::consts::PI * sides;
             tri.emitter = NO_EMITTER;
+            let mode = parts.textures.materials.get(tri.material as usize).map_or(ALPHA_OPAQUE, |t| t.alpha_mode);
+            tri.alpha_tested = (mode != ALPHA_OPAQUE) as u32;
             if power > 0.0 {
                 tri.emitter = emitter_tris.len() as u32;
                 emitter_tris.push(i as u32);

@@ -4,6 +4,7 @@
 //! the reuse estimator the ReSTIR passes implement.
 
 pub mod alpha;
+pub mod alpha_pass;
 pub mod bsdf;
 pub mod candidates;
 pub mod gris;

@@ -74,7 +74,7 @@ pub fn alpha_random_scene(seed: u64) -> Scene {
             e1: (v[1] - v[0]).into(),
             emitter: NO_EMITTER,
             e2: (v[2] - v[0]).into(),
-            pad: 0,
+            alpha_tested: 0,
         });
         let mut a = TriangleSurface::flat();
         for k in 0..3 {

@@ -77,7 +77,7 @@ fn random_scene_full(
             e1: (v[1] - v[0]).into(),
             emitter: NO_EMITTER,
             e2: (v[2] - v[0]).into(),
-            pad: 0,
+            alpha_tested: 0,
         });
     }
     let sphere = MeshData::sphere(Vec3::new(1.0, 0.5, -0.5), 2.0, 16, 32);
@@ -89,7 +89,7 @@ fn random_scene_full(
             e1: (b - a).into(),
             emitter: NO_EMITTER,
             e2: (c - a).into(),
-            pad: 0,
+            alpha_tested: 0,
         });
     }
     let materials = vec![

@@ -76,7 +76,7 @@ type StructLayout = (&'static str, usize, Vec<(String, u32)>);
 fn scene_structs() -> Vec<StructLayout> {
     vec![
         rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, specular, specular_color, pad),
-        rust_fields!(Triangle: v0, material, e1, emitter, e2, pad),
+        rust_fields!(Triangle: v0, material, e1, emitter, e2, alpha_tested),
         rust_fields!(BvhNode: lo, skip, hi, leaf),
         rust_fields!(Emitter: triangle, select_pdf, alias_prob, alias),
         rust_fields!(FrameParams: cam_position, cam_right, cam_up, cam_forward, scene_env, width, height, sample_offset,

@@ -27,7 +27,7 @@ fn random_triangle(r: &mut TestRng, center: DVec3, scale: f64) -> Option<Triangl
         e1: (v[1].as_vec3() - v0).into(),
         emitter: NO_EMITTER,
         e2: (v[2].as_vec3() - v0).into(),
-        pad: 0,
+        alpha_tested: 0,
     };
     let (e1, e2) = (dvec(tri.e1), dvec(tri.e2));
     let smallest = e1.angle_between(e2).min(e1.angle_between(e1 - e2)).min(e2.angle_between(e2 - e1));

@@ -97,7 +97,7 @@ pub fn textured_random_scene(seed: u64) -> Scene {
             e1: (v[1] - v[0]).into(),
             emitter: NO_EMITTER,
             e2: (v[2] - v[0]).into(),
-            pad: 0,
+            alpha_tested: 0,
         });
         surfaces.push(random_attributes(&mut r));
     }
