@@ -34,7 +34,11 @@ pub fn bvh_alpha_pass(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec
                 alpha_pass_record(p, i, tri.alpha_tested, t, bary);
             }
         }
-        node = if any_hit && p.opaque.triangle != NO_HIT { nodes.len() } else { n.skip as usize };
+        node = if any_hit && p.opaque.triangle != NO_HIT {
+            nodes.len()
+        } else {
+            n.skip as usize
+        };
     }
 }
 
@@ -54,7 +58,16 @@ pub fn bvh_traverse(nodes: &[BvhNode], triangles: &[Triangle], alpha: &AlphaScen
 
 /// Tests triangle index `i` for the closest ray (if `enter_c`) and the shadow ray (if `enter_s`).
 #[allow(clippy::too_many_arguments)]
-fn alpha_pair_test(triangles: &[Triangle], i: u32, closest: &PairRay, shadow: &PairRay, enter_c: bool, enter_s: bool, c: &mut AlphaPass, s: &mut AlphaPass) {
+fn alpha_pair_test(
+    triangles: &[Triangle],
+    i: u32,
+    closest: &PairRay,
+    shadow: &PairRay,
+    enter_c: bool,
+    enter_s: bool,
+    c: &mut AlphaPass,
+    s: &mut AlphaPass,
+) {
     let tri = &triangles[i as usize];
     if enter_c {
         if let Some((t, bary)) = intersect_triangle(closest.origin, closest.dir, tri, c.opaque.t) {
@@ -112,13 +125,24 @@ pub fn trace_pair_alpha_pass(
             let enter_s_now = enter_s && s.opaque.triangle == NO_HIT;
             alpha_pair_test(triangles, i, closest, shadow, enter_c, enter_s_now, c, s);
         }
-        node = if s.opaque.triangle != NO_HIT && !open_c { nodes.len() } else { n.skip as usize };
+        node = if s.opaque.triangle != NO_HIT && !open_c {
+            nodes.len()
+        } else {
+            n.skip as usize
+        };
     }
 }
 
 /// Twin of GLSL `trace_pair` with `SCENE_ALPHA`: the closest kept hit of `closest` and whether
 /// a kept hit blocks `shadow`, in passes over both rays until each is resolved.
-pub fn trace_pair(nodes: &[BvhNode], triangles: &[Triangle], alpha: &AlphaScene, brute_force: bool, closest: PairRay, shadow: PairRay) -> (Hit, bool) {
+pub fn trace_pair(
+    nodes: &[BvhNode],
+    triangles: &[Triangle],
+    alpha: &AlphaScene,
+    brute_force: bool,
+    closest: PairRay,
+    shadow: PairRay,
+) -> (Hit, bool) {
     let mut c = alpha_pass_new(closest.tmax);
     let mut s = alpha_pass_new(shadow.tmax);
     let mut hit = c.opaque;

@@ -1,7 +1,7 @@
 //! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
 
-pub mod bundled_scenes;
 pub mod alpha_trace;
+pub mod bundled_scenes;
 pub mod bvh;
 mod camera;
 pub mod environment;
@@ -123,7 +123,11 @@ impl Scene {
             let sides = if m.is_double_sided() { 2.0 } else { 1.0 };
             let power = luminance(Vec3::from(m.emission)) * tri.area() * std::f32::consts::PI * sides;
             tri.emitter = NO_EMITTER;
-            let mode = parts.textures.materials.get(tri.material as usize).map_or(ALPHA_OPAQUE, |t| t.alpha_mode);
+            let mode = parts
+                .textures
+                .materials
+                .get(tri.material as usize)
+                .map_or(ALPHA_OPAQUE, |t| t.alpha_mode);
             tri.alpha_tested = (mode != ALPHA_OPAQUE) as u32;
             if power > 0.0 {
                 tri.emitter = emitter_tris.len() as u32;

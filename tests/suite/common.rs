@@ -116,6 +116,20 @@ pub fn run_surface_set0_oracle(
     items: usize,
     rows_per_item: usize,
 ) -> Vec<glam::Vec4> {
+    run_surface_set0_oracle_with(ctx, scene_gpu, kernel, &[], inputs, items, rows_per_item)
+}
+
+/// [`run_surface_set0_oracle`] with `extra` defines after the scene's (e.g. SCENE_BRUTE_FORCE,
+/// which the path tracer adds for small scenes).
+pub fn run_surface_set0_oracle_with(
+    ctx: &Arc<Context>,
+    scene_gpu: &SceneGpu,
+    kernel: &str,
+    extra: &[(&'static str, &'static str)],
+    inputs: &[glam::Vec4],
+    items: usize,
+    rows_per_item: usize,
+) -> Vec<glam::Vec4> {
     use restir_pt::gpu_types::FrameParams;
     use restir_pt::shader_interface::SurfaceBinding;
     use restir_pt::vk::{Binding, BufferUsage};
@@ -137,7 +151,9 @@ pub fn run_surface_set0_oracle(
         BindingSlot::storage(10, "Outputs").to(&output),
     ]);
     let layout: Vec<BindingSlot> = buffers.iter().map(|b| b.slot).collect();
-    let k = Kernel::new(ctx, kernel, &scene_gpu.defines(), &layout, 4).unwrap();
+    let mut defines = scene_gpu.defines();
+    defines.extend_from_slice(extra);
+    let k = Kernel::new(ctx, kernel, &defines, &layout, 4).unwrap();
     k.bind(&buffers).unwrap();
     k.run_1d(items as u32, 64, bytemuck::bytes_of(&(items as u32))).unwrap();
     bytemuck::cast_slice(&output.read::<u32>(items * rows_per_item * 4).unwrap()).to_vec()
