@@ -36,14 +36,13 @@ void alpha_pass_begin(inout AlphaPass p, float tmax) {
 
 // Records the hit of triangle index i at distance t (< p.opaque.t, as intersect_triangle with
 // tmax p.opaque.t returns it) and barycentrics bary. `alpha_tested` is the triangle's flag.
+// Straight-line code: an early return here costs llvmpipe 13% of an alpha-tested scene's time.
 void alpha_pass_record(inout AlphaPass p, uint i, uint alpha_tested, float t, vec2 bary) {
-    if (t < p.bound_t || (t == p.bound_t && i <= p.bound_triangle)) return;
-    if (alpha_tested == 0u) {
-        p.opaque = Hit(t, i, bary);
-        return;
-    }
-    p.count += 1u;
-    if (t < p.tested.t) p.tested = Hit(t, i, bary);
+    bool counts = t > p.bound_t || (t == p.bound_t && i > p.bound_triangle);
+    bool opaque = alpha_tested == 0u;
+    if (counts && opaque) p.opaque = Hit(t, i, bary);
+    if (counts && !opaque) p.count += 1u;
+    if (counts && !opaque && t < p.tested.t) p.tested = Hit(t, i, bary);
 }
 
 // After a pass of the ray (o, d): true with its hit when done, false (the bound moved past the

@@ -58,16 +58,16 @@ pub fn alpha_pass_begin(p: &mut AlphaPass, tmax: f32) {
 /// `intersect_triangle` with that tmax returns it) and barycentrics `bary`; `alpha_tested` is
 /// the triangle's [`Triangle::alpha_tested`] flag.
 pub fn alpha_pass_record(p: &mut AlphaPass, i: u32, alpha_tested: u32, t: f32, bary: Vec2) {
-    if t < p.bound_t || (t == p.bound_t && i <= p.bound_triangle) {
-        return;
-    }
-    if alpha_tested == 0 {
+    let counts = t > p.bound_t || (t == p.bound_t && i > p.bound_triangle);
+    let opaque = alpha_tested == 0;
+    if counts && opaque {
         p.opaque = Hit { t, triangle: i, bary };
-        return;
     }
-    p.count += 1;
-    if t < p.tested.t {
-        p.tested = Hit { t, triangle: i, bary };
+    if counts && !opaque {
+        p.count += 1;
+        if t < p.tested.t {
+            p.tested = Hit { t, triangle: i, bary };
+        }
     }
 }
 
