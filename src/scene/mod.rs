@@ -102,6 +102,28 @@ pub struct SceneParts {
     pub warnings: Vec<String>,
 }
 
+/// Sets each triangle's emitter index (into the triangle emitters, in order; `NO_EMITTER` if it
+/// emits nothing) and `alpha_tested` flag; returns the emitting triangles' indices and powers
+/// (luminance × area × π per emitting side, in scene units).
+fn tag_triangles(triangles: &mut [Triangle], materials: &[Material], textures: &SceneTextures) -> (Vec<u32>, Vec<f32>) {
+    let mut emitter_tris = Vec::new();
+    let mut powers = Vec::new();
+    for (i, tri) in triangles.iter_mut().enumerate() {
+        let m = &materials[tri.material as usize];
+        let sides = if m.is_double_sided() { 2.0 } else { 1.0 };
+        let power = luminance(Vec3::from(m.emission)) * tri.area() * std::f32::consts::PI * sides;
+        tri.emitter = NO_EMITTER;
+        let mode = textures.materials.get(tri.material as usize).map_or(ALPHA_OPAQUE, |t| t.alpha_mode);
+        tri.alpha_tested = (mode != ALPHA_OPAQUE) as u32;
+        if power > 0.0 {
+            tri.emitter = emitter_tris.len() as u32;
+            emitter_tris.push(i as u32);
+            powers.push(power);
+        }
+    }
+    (emitter_tris, powers)
+}
+
 impl Scene {
     /// Builds the BVH (reordering triangles) and the emitter table. Triangles must be
     /// non-degenerate and finite; the loader guarantees it.
@@ -116,25 +138,7 @@ impl Scene {
             permute_in_place(&mut surfaces, bvh.order.clone());
         }
         permute_in_place(&mut triangles, bvh.order);
-        let mut emitter_tris = Vec::new();
-        let mut powers = Vec::new();
-        for (i, tri) in triangles.iter_mut().enumerate() {
-            let m = &parts.materials[tri.material as usize];
-            let sides = if m.is_double_sided() { 2.0 } else { 1.0 };
-            let power = luminance(Vec3::from(m.emission)) * tri.area() * std::f32::consts::PI * sides;
-            tri.emitter = NO_EMITTER;
-            let mode = parts
-                .textures
-                .materials
-                .get(tri.material as usize)
-                .map_or(ALPHA_OPAQUE, |t| t.alpha_mode);
-            tri.alpha_tested = (mode != ALPHA_OPAQUE) as u32;
-            if power > 0.0 {
-                tri.emitter = emitter_tris.len() as u32;
-                emitter_tris.push(i as u32);
-                powers.push(power);
-            }
-        }
+        let (mut emitter_tris, mut powers) = tag_triangles(&mut triangles, &parts.materials, &parts.textures);
         let triangle_power = powers.iter().fold(0.0, |a, p| a + p);
         // Punctual lights join the alias table after the triangles, chosen by power too.
         let bounds = (Vec3::from(bvh.nodes[0].lo), Vec3::from(bvh.nodes[0].hi));
