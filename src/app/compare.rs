@@ -30,7 +30,9 @@ pub struct CompareArgs {
     /// Path-traced reference EXR (see `reference`); it sets the resolution.
     #[arg(long)]
     pub reference: PathBuf,
-    /// Methods: pt, restir:reconnection, restir:replay, restir:hybrid (optionally /gbh or /pairwise).
+    /// Methods: pt, restir (the ReSTIR options' settings), restir:reconnection|replay|hybrid,
+    /// each ReSTIR form optionally with /gbh or /pairwise and @sK (K spatial neighbours; @s0:
+    /// spatial reuse off), e.g. pt,restir,restir@s0.
     #[arg(long, value_delimiter = ',', default_value = DEFAULT_METHODS)]
     pub methods: Vec<String>,
     /// GPU ms per frame (default: ReSTIR PT's cheapest frame times 1.05, 2.1 and 4.2). Each method
@@ -304,7 +306,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     settings.validate(&SceneInfo::of(&scene))?;
     for m in &methods {
         if let MethodSpec::Restir(r) = m {
-            r.validate(settings.max_depth)?;
+            r.validate(settings.max_depth).with_context(|| format!("--methods {}", m.label()))?;
         }
     }
     // The error is measured on the last frame, seen from this camera.
