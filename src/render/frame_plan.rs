@@ -7,12 +7,16 @@ use crate::gpu_types::{RestirPass, RESTIR_MAX_PASSES};
 /// The kernels of a frame (glsl/restir_*.comp).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PassKernel {
+    /// Initial candidates: traces each pixel's candidate paths and resamples them into a
+    /// reservoir (glsl/restir_initial.comp).
     Initial,
     /// Temporal reuse with shifts, for a moved camera.
     Temporal,
     /// Temporal reuse of an unmoved camera, compiled without shift code.
     TemporalUnmoved,
+    /// One round of spatial reuse from neighbouring pixels (glsl/restir_spatial.comp).
     Spatial,
+    /// Shades the final reservoirs and accumulates the frame (glsl/restir_shade.comp).
     Shade,
 }
 
@@ -83,14 +87,19 @@ pub enum History {
 /// One dispatch of a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PlannedPass {
+    /// The kernel dispatched.
     pub kernel: PassKernel,
+    /// Its entry of the pass table: the reservoir and surface slots it reads and writes, and
+    /// its random-number key.
     pub slots: RestirPass,
 }
 
 /// A frame's dispatches, and the slot of the reservoirs the next frame's temporal reuse reads.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FramePlan {
+    /// The dispatches in order (at most `RESTIR_MAX_PASSES`).
     pub passes: Vec<PlannedPass>,
+    /// The reservoir slot (0-2) the next frame's temporal reuse reads ([`History`] decides which).
     pub final_slot: u32,
 }
 
