@@ -35,9 +35,12 @@ pub struct ContextOptions {
 pub struct DeviceInfo {
     /// The driver's device name (e.g. "llvmpipe (LLVM 15.0.7, 256 bits)").
     pub name: String,
+    /// CPU (lavapipe), integrated, discrete...: CPU devices get uniform-buffer scene bindings and
+    /// longer submissions.
     pub device_type: vk::PhysicalDeviceType,
-    /// maxStorageBufferRange and maxUniformBufferRange, in bytes.
+    /// maxStorageBufferRange: the most bytes one storage-buffer binding may cover.
     pub max_storage_buffer_range: u64,
+    /// maxUniformBufferRange: the most bytes one uniform-buffer binding may cover.
     pub max_uniform_buffer_range: u64,
     /// Bytes one scene array may take in a binding (maxStorageBufferRange, or less where
     /// `ContextOptions::scene_binding_limit` says so); larger ones are addressed.
@@ -49,9 +52,11 @@ pub struct DeviceInfo {
     pub max_allocation_bytes: u64,
     /// Bytes of shared memory a compute workgroup may use (Vulkan's floor: 16384).
     pub max_compute_shared_memory: u32,
-    /// Nanoseconds per timestamp tick (timestampPeriod), and whether the compute queue writes
-    /// timestamps at all (GPU times are reported as 0 where it does not).
+    /// Nanoseconds per timestamp tick (timestampPeriod).
     pub timestamp_period_ns: f32,
+    /// Whether the compute queue writes timestamps (timestampValidBits > 0 and
+    /// timestampComputeAndGraphics); without them GPU times are not measured
+    /// ([`crate::vk::PassTimer::read_ms`] gives `None`).
     pub timestamps_supported: bool,
     /// Iterations each loop of one shader invocation may run in total before the driver silently
     /// leaves it (llvmpipe: 65535); `None` where no such cap is known.
@@ -100,10 +105,14 @@ unsafe extern "system" fn debug_callback(
 pub struct Context {
     allocator: ManuallyDrop<Mutex<Allocator>>,
     command_pool: vk::CommandPool,
-    /// The raw handles, for code that records its own Vulkan work.
+    /// The compute queue every submission goes to; with the handles below, for code that
+    /// records its own Vulkan work.
     pub queue: vk::Queue,
+    /// The compute queue's family index.
     pub queue_family: u32,
+    /// The logical device (ash's loaded function table).
     pub device: ash::Device,
+    /// The physical device chosen.
     pub physical_device: vk::PhysicalDevice,
     /// The device's name and limits.
     pub info: DeviceInfo,
