@@ -234,7 +234,8 @@ pub struct ReuseParams {
     /// Neighbours need |depth' - |x - camera'|| <= this * depth', x the canonical pixel's hit: a
     /// relative depth tolerance.
     pub depth_threshold: f32,
-    /// Frames rendered since the last reset; keys the frame's random numbers.
+    /// Frames rendered since the renderer was built or last reset; keys the frame's random
+    /// numbers.
     pub frame_index: u32,
     /// Initial candidate paths per pixel and reservoir.
     pub candidates: u32,
