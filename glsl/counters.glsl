@@ -29,10 +29,23 @@ const uint COUNTER_STEP_ITERATIONS = 6u;
 uint profile_counts[COUNTER_COUNT] = uint[COUNTER_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u);
 #endif
 
+// A kernel compiled with COUNT_TRAVERSALS=1 counts the traversals each lane starts apart from
+// the profile counters, always on: the ReSTIR PT reuse kernels, whose every traversal belongs to
+// a shift, report them per frame (rays per shift; RestirStats::reuse_traversals).
+#ifndef COUNT_TRAVERSALS
+#define COUNT_TRAVERSALS 0
+#endif
+#if COUNT_TRAVERSALS
+uint traversals_started = 0u;
+#endif
+
 // Counts one event of this lane.
 void count_lane(uint counter) {
 #if TRAVERSAL_COUNTERS
     profile_counts[counter] += 1u;
+#endif
+#if COUNT_TRAVERSALS
+    if (counter == COUNTER_TRAVERSALS) traversals_started += 1u;
 #endif
 }
 

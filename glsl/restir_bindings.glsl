@@ -13,6 +13,7 @@
 #include "scene_bindings.glsl"
 #include "reservoir.glsl"
 #include "loop_budget.glsl"
+#include "counters.glsl"
 
 // Which slots a pass reads and writes, and its random-number key.
 struct RestirPass {
@@ -73,7 +74,9 @@ layout(std430, set = 0, binding = RESTIR_BINDING_RESTIR_STATS) buffer RestirStat
     uint nonfinite_weights;
     uint candidates_dropped;
     uint nonfinite_pixels;
-    uint stats_pad;
+    uint reuse_traversals;     // traversals started by the reuse kernels, all inside shifts
+    uint shift_subgroup_runs;  // runs of the shift code by a subgroup, whichever lanes shift
+    uint subgroup_size;        // lanes of a subgroup (llvmpipe: one SIMD group)
 };
 // rgb: the expectation of f(Y) W_Y over the last resampling's choice (see Resampler), written by
 // whichever pass last resampled the pixel.
@@ -137,6 +140,7 @@ uint local_shifts_failed = 0u;
 uint local_nonfinite_weights = 0u;
 uint local_candidates_dropped = 0u;
 uint local_nonfinite_pixels = 0u;
+uint local_shift_runs = 0u;   // counted by one lane of the subgroup (see shift_path)
 
 // Call once at the end of main(), from uniform control flow.
 void report_pass_stats() {
@@ -147,6 +151,12 @@ void report_pass_stats() {
     uint nonfinite = subgroupAdd(local_nonfinite_weights);
     uint dropped = subgroupAdd(local_candidates_dropped);
     uint pixels = subgroupAdd(local_nonfinite_pixels);
+    uint shift_runs = subgroupAdd(local_shift_runs);
+#if COUNT_TRAVERSALS
+    uint traversals = subgroupAdd(traversals_started);
+#else
+    uint traversals = 0u;
+#endif
     if (subgroupElect()) {
         atomicMax(max_loop_iterations, iterations);
         if (cut) atomicAdd(loop_budget_cut_groups, 1u);
@@ -155,6 +165,11 @@ void report_pass_stats() {
         if (nonfinite > 0u) atomicAdd(nonfinite_weights, nonfinite);
         if (dropped > 0u) atomicAdd(candidates_dropped, dropped);
         if (pixels > 0u) atomicAdd(nonfinite_pixels, pixels);
+        if (traversals > 0u) atomicAdd(reuse_traversals, traversals);
+        if (shift_runs > 0u) {
+            atomicAdd(shift_subgroup_runs, shift_runs);
+            atomicMax(subgroup_size, gl_SubgroupSize);
+        }
     }
 }
 

@@ -6,6 +6,9 @@
 #ifndef RESTIR_REUSE_GLSL
 #define RESTIR_REUSE_GLSL
 
+// Every traversal of a reuse kernel belongs to a shift; counting them gives rays per shift.
+#define COUNT_TRAVERSALS 1
+
 #include "restir_bindings.glsl"
 #include "camera.glsl"
 #include "gris.glsl"
@@ -97,6 +100,9 @@ ShiftParams reuse_shift_params() {
 // the reuse kernels"). Within one domain the shift is the identity, which callers skip.
 ShiftResult shift_path(PathRecord record, Domain to) {
     local_shifts_attempted += 1u;
+    // The subgroup runs this code once for all its lanes that shift here: lanes busy in shifts
+    // are shifts_attempted / (shift_subgroup_runs * subgroup_size).
+    if (subgroupElect()) local_shift_runs += 1u;
     vec3 camera;
     Vertex v1;
     ShiftResult s = shift_failed();

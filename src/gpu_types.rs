@@ -330,8 +330,13 @@ pub struct RestirStats {
     pub candidates_dropped: u32,
     /// Pixels whose shaded estimate was NaN or infinite.
     pub nonfinite_pixels: u32,
-    /// Padding to 32 bytes; always 0.
-    pub stats_pad: u32,
+    /// Traversals (a closest-hit or shadow ray, or a pair traced together) started by the
+    /// temporal and spatial kernels, every one of them inside a shift.
+    pub reuse_traversals: u32,
+    /// Runs of the shift code by a subgroup, counted once for all its lanes that shift.
+    pub shift_subgroup_runs: u32,
+    /// Lanes per subgroup (llvmpipe: one SIMD group run in lockstep); 0 if no shift ran.
+    pub subgroup_size: u32,
 }
 
 /// One entry of the ReSTIR kernels' pass table (ReuseParams::passes): which slots a pass reads

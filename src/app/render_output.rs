@@ -80,6 +80,10 @@ pub struct RestirFrameReport {
     pub shifts_attempted: u32,
     pub shifts_failed: u32,
     pub failed_shift_rate: f64,
+    /// Traversals per attempted shift (FrameStats::traversals_per_shift).
+    pub traversals_per_shift: Option<f64>,
+    /// Share of SIMD lanes busy while the shift code runs (FrameStats::shift_lane_use).
+    pub shift_lane_use: Option<f64>,
     pub nonfinite_weights: u32,
     pub nonfinite_pixels: u32,
     pub candidates_dropped: u32,
@@ -97,6 +101,8 @@ impl RestirFrameReport {
             shifts_attempted: c.shifts_attempted,
             shifts_failed: c.shifts_failed,
             failed_shift_rate: stats.failed_shift_rate(),
+            traversals_per_shift: stats.traversals_per_shift(),
+            shift_lane_use: stats.shift_lane_use(),
             nonfinite_weights: c.nonfinite_weights,
             nonfinite_pixels: c.nonfinite_pixels,
             candidates_dropped: c.candidates_dropped,
@@ -106,8 +112,12 @@ impl RestirFrameReport {
     /// Pass times and failed shifts; the non-finite counts are the common summary's.
     pub fn summary(&self) -> String {
         let passes: Vec<String> = self.pass_ms.iter().map(|(n, t)| format!("{n} {t:.1}")).collect();
+        let shifts = match (self.traversals_per_shift, self.shift_lane_use) {
+            (Some(rays), Some(lanes)) => format!(", {rays:.2} rays per shift, lanes busy in shifts {:.0}%", 100.0 * lanes),
+            _ => String::new(),
+        };
         format!(
-            "passes ms: {} | failed shifts {}/{} ({:.1}%)",
+            "passes ms: {} | failed shifts {}/{} ({:.1}%){shifts}",
             if passes.is_empty() { "n/a".to_string() } else { passes.join(", ") },
             self.shifts_failed,
             self.shifts_attempted,

@@ -57,6 +57,23 @@ impl FrameStats {
             c.shifts_failed as f64 / c.shifts_attempted as f64
         }
     }
+
+    /// Traversals per attempted shift in the temporal and spatial passes (each shift traces
+    /// at least its primary ray, so at least 1); None if no shift was attempted.
+    pub fn traversals_per_shift(&self) -> Option<f64> {
+        let c = &self.counters;
+        (c.shifts_attempted > 0).then(|| c.reuse_traversals as f64 / c.shifts_attempted as f64)
+    }
+
+    /// Share of SIMD lanes doing a shift while their subgroup runs the shift code (in 0..=1):
+    /// shifts attempted over (subgroup runs of the shift code × lanes per subgroup). The rest
+    /// idle under the mask, their pixel having no input to shift at that step; None if no shift
+    /// ran.
+    pub fn shift_lane_use(&self) -> Option<f64> {
+        let c = &self.counters;
+        let slots = c.shift_subgroup_runs as f64 * c.subgroup_size as f64;
+        (slots > 0.0).then(|| c.shifts_attempted as f64 / slots)
+    }
 }
 
 /// ReSTIR PT on one uploaded scene at one resolution: one `frame` per camera pose, with the

@@ -233,6 +233,12 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
     // --spatial 2 is not the default, so the label names it.
     assert_eq!(json["method"], "restir:reconnection/pairwise@s2");
     assert!(json["restir"]["shifts_attempted"].as_u64().unwrap() > 0, "{json}");
+    // Every shift traces its primary ray, and a run of the shift code keeps at least one lane busy.
+    let rays = json["restir"]["traversals_per_shift"].as_f64().unwrap();
+    let lanes = json["restir"]["shift_lane_use"].as_f64().unwrap();
+    assert!((1.0..10.0).contains(&rays), "rays per shift {rays}");
+    assert!(lanes > 0.0 && lanes <= 1.0, "lanes busy in shifts {lanes}");
+    assert!(last.contains("rays per shift") && last.contains("lanes busy in shifts"), "{last}");
     assert!(exr.exists());
     assert_clean_failure(&["render", "--max-depth", "8"], &["--max-depth 8", "at most 7"]);
     assert_clean_failure(&["render", "--spatial", "9"], &["--spatial 9"]);

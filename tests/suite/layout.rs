@@ -146,7 +146,7 @@ fn restir_structs_match_glsl_layout() {
         rust_fields!(ReservoirHead: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry),
         rust_fields!(ReservoirTail: suffix, rc_pdf_after, contribution, rc_next_triangle, weight, confidence, pad0, pad1),
         rust_fields!(RestirStats: max_loop_iterations, loop_budget_cut_groups, shifts_attempted, shifts_failed, nonfinite_weights,
-            candidates_dropped, nonfinite_pixels, stats_pad),
+            candidates_dropped, nonfinite_pixels, reuse_traversals, shift_subgroup_runs, subgroup_size),
         rust_fields!(RestirPass: in_slot, out_slot, prev_slot, surface_slot, pass_seed),
     ];
     assert_eq!(check_layout("restir_spatial.comp", &[], structs), 6);
