@@ -23,11 +23,11 @@ pub struct Material {
     pub emission: [f32; 3],
     /// Perceptual (linear) roughness in [0, 1]; the GGX alpha is its square ([`crate::shading::bsdf::ggx_alpha`]).
     pub roughness: f32,
-    /// `KHR_materials_transmission` transmissionFactor in [0, 1]: the share of the non-metal part
-    /// that is a dielectric interface instead of a diffuse base.
+    /// `KHR_materials_transmission` transmissionFactor in [0, 1]: the weight t of the dielectric
+    /// interface lobe; the non-metal and conductor lobes share 1 - t (`bsdf::lobe_weights`).
     pub transmission: f32,
     /// Index of refraction of the inside (`KHR_materials_ior`, glTF default 1.5); also sets the
-    /// non-metal F0 = ((ior - 1) / (ior + 1))².
+    /// specular layer's F0 = ((ior - 1) / (ior + 1))² · specular_color.
     pub ior: f32,
     /// Bit set: [`MATERIAL_DOUBLE_SIDED`].
     pub flags: u32,

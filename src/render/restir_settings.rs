@@ -10,13 +10,16 @@ use crate::shading::path_record::MAX_PATH_LENGTH;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 #[repr(u32)]
 pub enum ShiftKind {
-    /// Reconnection shift: the offset path takes its own primary hit and joins the base path at
-    /// the reconnection vertex x_r (Lin et al. 2022).
+    /// Reconnection shift: the offset path keeps its own primary hit y1 and connects it to the
+    /// base path's x2, keeping x2..xk; defined only where the base reconnects at r = 2
+    /// (docs/shift-mappings.md).
     Reconnection = 0,
-    /// Random replay: the offset path is traced anew from the base path's random numbers.
+    /// Random replay: the offset path is traced anew from y1 with the base path's random numbers;
+    /// its Jacobian is 1.
     Replay = 1,
-    /// Hybrid shift: random replay up to the reconnection vertex, reconnection there (Lin et
-    /// al. 2022, the default).
+    /// Hybrid shift (Lin et al. 2022; the default): random replay of y2..y_{r-1}, then a
+    /// reconnection to the base path's x_r; random replay alone where the base has no
+    /// reconnection vertex.
     Hybrid = 2,
 }
 

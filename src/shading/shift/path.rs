@@ -55,8 +55,8 @@ pub struct ShiftResult {
     pub valid: bool,
     /// The shifted path's record, as a reservoir would store it.
     pub record: PathRecord,
-    /// |∂T(x)/∂x|, the shift's Jacobian determinant in the measure the target function uses
-    /// (finite and positive when valid).
+    /// The shift's Jacobian determinant in primary sample space, |dU_Y / dU_X|
+    /// (docs/shift-mappings.md); finite and positive when valid.
     pub jacobian: f32,
     /// f(T(x)) of the shifted path, linear RGB (the record's contribution).
     pub contribution: Vec3,
