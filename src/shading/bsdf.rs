@@ -46,7 +46,7 @@ pub struct BsdfSample {
     /// f · |cos θi| / pdf, linear RGB: the path throughput factor of this bounce.
     pub weight: Vec3,
     /// Solid-angle density of `wi` summed over the non-delta lobes (1/sr), or for a delta lobe
-    /// the probability of choosing that lobe.
+    /// the discrete probability of that choice.
     pub pdf: f32,
     /// The `LOBE_*` bits of the lobe that produced `wi`.
     pub lobe: u32,

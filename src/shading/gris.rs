@@ -28,7 +28,7 @@ pub enum Mis {
 pub struct Input<S> {
     /// X_i, in input i's own domain.
     pub sample: S,
-    /// W_{X_i}: an unbiased estimate of 1 / p(X_i) (Lin et al. 2022, section 4).
+    /// W_{X_i}: an unbiased estimate of 1 / p(X_i) (Lin et al. 2022).
     pub contribution_weight: f64,
     /// c_i, the number of candidates X_i stands for (ReSTIR's M); weights the MIS.
     pub confidence: f64,

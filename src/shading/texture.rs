@@ -103,7 +103,8 @@ pub struct SceneTextures {
 }
 
 impl SceneTextures {
-    /// Whether no material has a texture or a non-opaque alpha mode (kernels then skip texturing).
+    /// Whether the scene has no material table: no material has a texture or a non-opaque alpha
+    /// mode.
     pub fn is_empty(&self) -> bool {
         self.materials.is_empty()
     }
