@@ -1,4 +1,6 @@
 //! Host twins of the records in glsl/types.glsl; `#[repr(C)]` so that a test can check offsets.
+//! Positions are in scene coordinates: world space moved by -`Scene::origin`
+//! ([`crate::scene::Scene`]).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -21,7 +23,8 @@ pub struct Material {
     /// Emitted radiance, linear RGB in W/(m² sr): emissiveFactor already multiplied by
     /// `KHR_materials_emissive_strength`.
     pub emission: [f32; 3],
-    /// Perceptual (linear) roughness in [0, 1]; the GGX alpha is its square ([`crate::shading::bsdf::ggx_alpha`]).
+    /// Perceptual (linear) roughness in [0, 1]; the GGX alpha is its square
+    /// ([`crate::shading::bsdf::ggx_alpha`]).
     pub roughness: f32,
     /// `KHR_materials_transmission` transmissionFactor in [0, 1]: the weight t of the dielectric
     /// interface lobe; the non-metal and conductor lobes share 1 - t (`bsdf::lobe_weights`).
@@ -40,21 +43,21 @@ pub struct Material {
     pub pad: u32,
 }
 
-/// A triangle in world space, stored as vertex 0 and two edges so that the ray-triangle test
+/// A triangle in scene coordinates, stored as vertex 0 and two edges so that the ray-triangle test
 /// (Möller-Trumbore) needs no subtraction (glsl/types.glsl `Triangle`, 48 bytes, std430). The
 /// counter-clockwise winding v0, v0 + e1, v0 + e2 defines the front face.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Triangle {
-    /// Vertex 0, world space.
+    /// Vertex 0, scene coordinates.
     pub v0: [f32; 3],
     /// Index into the scene's materials.
     pub material: u32,
-    /// Vertex 1 minus vertex 0, world space.
+    /// Vertex 1 minus vertex 0, scene coordinates.
     pub e1: [f32; 3],
     /// Index into the emitter table, or [`NO_EMITTER`] if the triangle does not emit.
     pub emitter: u32,
-    /// Vertex 2 minus vertex 0, world space.
+    /// Vertex 2 minus vertex 0, scene coordinates.
     pub e2: [f32; 3],
     /// Padding to a 16-byte multiple (std430); always 0.
     pub pad: u32,
@@ -67,11 +70,11 @@ pub struct Triangle {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhNode {
-    /// Minimum corner of the node's bounding box, world space.
+    /// Minimum corner of the node's bounding box, scene coordinates.
     pub lo: [f32; 3],
     /// Index of the node to visit after this subtree (or after a missed box).
     pub skip: u32,
-    /// Maximum corner of the node's bounding box, world space.
+    /// Maximum corner of the node's bounding box, scene coordinates.
     pub hi: [f32; 3],
     /// For a leaf, `(first triangle << LEAF_COUNT_BITS) | count` (see [`BvhNode::leaf_range`]);
     /// 0 for an interior node.
@@ -148,7 +151,7 @@ impl Material {
 }
 
 impl Triangle {
-    /// The three vertices in world space, in winding order.
+    /// The three vertices in scene coordinates, in winding order.
     pub fn vertices(&self) -> [glam::Vec3; 3] {
         let v0 = glam::Vec3::from(self.v0);
         [v0, v0 + glam::Vec3::from(self.e1), v0 + glam::Vec3::from(self.e2)]
@@ -159,7 +162,7 @@ impl Triangle {
         glam::Vec3::from(self.e1).cross(glam::Vec3::from(self.e2))
     }
 
-    /// Area in square scene units (world space).
+    /// Area in square scene units.
     pub fn area(&self) -> f32 {
         0.5 * self.normal_area2().length()
     }
@@ -173,14 +176,14 @@ pub const FLAG_RUSSIAN_ROULETTE: u32 = 1;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct FrameParams {
-    /// xyz: camera position, world space; w: tan(vertical field of view / 2) for this image
+    /// xyz: camera position, scene coordinates; w: tan(vertical field of view / 2) for this image
     /// ([`crate::scene::Camera::fill_params`]).
     pub cam_position: [f32; 4],
-    /// xyz: the camera's unit right axis, world space; w: aspect ratio width / height.
+    /// xyz: the camera's unit right axis, scene coordinates; w: aspect ratio width / height.
     pub cam_right: [f32; 4],
-    /// xyz: the camera's unit up axis, world space; w unused (0).
+    /// xyz: the camera's unit up axis, scene coordinates; w unused (0).
     pub cam_up: [f32; 4],
-    /// xyz: the camera's unit viewing direction, world space; w unused (0).
+    /// xyz: the camera's unit viewing direction, scene coordinates; w unused (0).
     pub cam_forward: [f32; 4],
     /// rgb: constant environment radiance (linear, W/(m² sr)); w: probability that light
     /// sampling picks the environment instead of an emitter.
@@ -257,11 +260,11 @@ pub struct ReuseParams {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Surface {
-    /// Hit point of the ray through the pixel centre, world space.
+    /// Hit point of the ray through the pixel centre, scene coordinates.
     pub pos: [f32; 3],
     /// The hit triangle, or [`crate::scene::bvh::NO_HIT`] if the camera ray escaped.
     pub triangle: u32,
-    /// The camera position the ray left from, world space.
+    /// The camera position the ray left from, scene coordinates.
     pub camera: [f32; 3],
     /// Distance from the camera to `pos`, scene units.
     pub depth: f32,

@@ -33,7 +33,7 @@ const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
 /// What one [`PathTracer::render`] call did and how long it took.
 pub struct RenderStats {
-    /// Samples per pixel accumulated so far (all calls since the last reset).
+    /// Samples per pixel accumulated so far, over every call since the tracer was built or reset.
     pub spp: u32,
     /// Milliseconds of GPU time of this call's dispatches, by timestamp queries; where the device
     /// has none, each submission's wall time instead.

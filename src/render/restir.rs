@@ -34,7 +34,7 @@ const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record:
 #[derive(Debug, Clone)]
 pub struct FrameStats {
     /// GPU milliseconds per pass, indexed like [`PASS_NAMES`] (initial, temporal, spatial, shade;
-    /// 0 for a pass the frame did not run); `None` where the device has no timestamp queries.
+    /// about 0 for a pass the frame did not run); `None` where the device has no timestamp queries.
     pub pass_ms: Option<[f64; 4]>,
     /// Wall-clock milliseconds of the frame, parameter upload and counter readback included.
     pub wall_ms: f64,

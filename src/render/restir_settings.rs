@@ -98,8 +98,8 @@ pub const MAX_EMISSION_RAYS: u32 = 64;
 pub const MAX_RESERVOIRS: u32 = 16;
 
 /// The ReSTIR PT options (Lin et al. 2022, on the reservoir reuse of Bitterli et al. 2020). Check
-/// them with [`RestirSettings::validate`] before building a [`super::Restir`]; the defaults are
-/// the measured best of docs/lab-notebook.md.
+/// them with [`RestirSettings::validate`] before building a [`super::Restir`]. Fields whose
+/// default was measured say where (docs/lab-notebook.md).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RestirSettings {
     /// The shift mapping of temporal and spatial reuse.

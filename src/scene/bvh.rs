@@ -321,9 +321,9 @@ pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: 
 /// A ray of `trace_pair`; `tmax <= 0` makes it inactive (no hit, no node visit of its own).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairRay {
-    /// Ray origin, world space (already offset off its surface).
+    /// Ray origin in scene coordinates (already offset off its surface).
     pub origin: Vec3,
-    /// Ray direction, world space; hits count for t in (0, tmax) in units of |dir|.
+    /// Ray direction in scene coordinates; hits count for t in (0, tmax) in units of |dir|.
     pub dir: Vec3,
     /// The farthest ray parameter that counts.
     pub tmax: f32,

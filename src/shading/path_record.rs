@@ -19,7 +19,7 @@ const INFO_NEE_END: u32 = 1 << 8;
 /// A reservoir's path sample (glsl/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
 /// GPU split into [`crate::gpu_types::ReservoirHead`] and [`crate::gpu_types::ReservoirTail`]).
 /// x_0 is the camera, x_1..x_k the path's vertices, x_r the reconnection vertex; positions and
-/// directions are in world space, colours linear RGB.
+/// directions are in scene coordinates, colours linear RGB.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct PathRecord {

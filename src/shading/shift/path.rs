@@ -24,7 +24,7 @@ use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 pub struct Path {
     /// The path's random-number key ([`crate::shading::rng::path_seed`]).
     pub seed: u32,
-    /// The camera position x0, world space.
+    /// The camera position x0, scene coordinates.
     pub camera: Vec3,
     /// x1..xk.
     pub vertices: Vec<Vertex>,

@@ -49,7 +49,7 @@ impl ShiftParams {
 /// A path vertex: a surface point, or (triangle == NO_HIT) a direction to the environment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Vertex {
-    /// The point, world space (a punctual light's position); for an escaped vertex or one on a
+    /// The point in scene coordinates (a punctual light's position); for an escaped vertex or one on a
     /// directional light, the unit direction towards the environment or the light.
     pub pos: Vec3,
     /// The geometric normal (unit, as wound; zero off surfaces); `vertex_shading` gives the
