@@ -34,7 +34,8 @@ enum Command {
     /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
     Reference(app::ReferenceArgs),
     /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out) and variance
-    /// EXR (<out>.variance.exr) one `reference` process of the same seed and spp writes.
+    /// EXR (<out>.variance.exr): the images one `reference` process of the same seed and spp
+    /// writes, up to the order of floating-point sums.
     Merge(app::MergeArgs),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
     Profile(app::ProfileArgs),

@@ -240,6 +240,16 @@ fn bad_geometry_and_materials() -> anyhow::Result<Vec<Case>> {
             }),
         ),
         ("index-out-of-range.gltf", serde_json::to_vec_pretty(&base(out_of_range, lamp()))?),
+        (
+            "index-accessor-overflow.gltf",
+            edited(|v| {
+                // One index more than the buffer view holds: without a check the reader gives up
+                // and the vertices would be drawn in order.
+                let i = v["meshes"][0]["primitives"][0]["indices"].as_u64().expect("indexed floor") as usize;
+                let count = v["accessors"][i]["count"].as_u64().expect("a count");
+                v["accessors"][i]["count"] = json!(count + 1);
+            }),
+        ),
         ("nan-position.gltf", serde_json::to_vec_pretty(&base(nan, lamp()))?),
         ("inf-position.gltf", serde_json::to_vec_pretty(&base(inf, lamp()))?),
         (

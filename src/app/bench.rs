@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use anyhow::{Context as _, Result};
+use anyhow::{bail, Context as _, Result};
 use serde::Serialize;
 
 use clap::Args;
@@ -134,7 +134,10 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     };
     settings.validate(&SceneInfo::of(&scene))?;
     let stage_load = lap.lap();
-    let runs = args.runs.max(1);
+    if args.runs == 0 {
+        bail!("--runs must be at least 1");
+    }
+    let runs = args.runs;
     let ctx = open_device(&args.device)?;
     let stage_device = lap.lap();
     let scene_gpu = SceneGpu::upload(&ctx, &scene)?;

@@ -30,7 +30,9 @@ pub struct CompareArgs {
     /// Path-traced reference EXR (see `reference`); it sets the resolution.
     #[arg(long)]
     pub reference: PathBuf,
-    /// Methods: pt, restir:reconnection, restir:replay, restir:hybrid (optionally /gbh or /pairwise).
+    /// Methods: pt, restir (the ReSTIR options' settings), restir:reconnection|replay|hybrid,
+    /// each ReSTIR form optionally with /gbh or /pairwise and @sK (K spatial neighbours; @s0:
+    /// spatial reuse off), e.g. pt,restir,restir@s0.
     #[arg(long, value_delimiter = ',', default_value = DEFAULT_METHODS)]
     pub methods: Vec<String>,
     /// GPU ms per frame (default: ReSTIR PT's cheapest frame times 1.05, 2.1 and 4.2). Each method
@@ -304,7 +306,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     settings.validate(&SceneInfo::of(&scene))?;
     for m in &methods {
         if let MethodSpec::Restir(r) = m {
-            r.validate(settings.max_depth)?;
+            r.validate(settings.max_depth).with_context(|| format!("--methods {}", m.label()))?;
         }
     }
     // The error is measured on the last frame, seen from this camera.
@@ -313,7 +315,16 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     } else {
         args.path.camera
     };
-    let reference_spp = check_reference(&args.reference, &path, last_camera)?.map(|r| r.spp);
+    let record = check_reference(&args.reference, &path, last_camera)?;
+    if let Some(r) = record.as_ref().filter(|r| (r.width, r.height) != (width, height)) {
+        bail!(
+            "{}: {width}x{height} pixels, but its record says {}x{}: the image and its .json record do not belong together",
+            args.reference.display(),
+            r.width,
+            r.height
+        );
+    }
+    let reference_spp = record.map(|r| r.spp);
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     Ok(Setup {
         path,

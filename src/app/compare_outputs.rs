@@ -80,10 +80,14 @@ pub(super) fn write_outputs(
     write_csv(&args.out_dir.join("results.csv"), rows)?;
     let motion = if args.camera_path { "a moving camera" } else { "a static camera" };
     let title = format!(
-        "{} {}x{}, frame {} of {motion}, {device}",
-        setup.path.display(),
+        "{} {}x{}, frame {} (the last of {}) of {motion}, {device}",
+        setup
+            .path
+            .file_name()
+            .map_or_else(|| setup.path.display().to_string(), |n| n.to_string_lossy().into_owned()),
         setup.width,
         setup.height,
+        args.frames - 1,
         args.frames
     );
     for (metric, name, value) in [
@@ -195,7 +199,7 @@ fn write_strip(
         pixels: reference,
     }];
     panels.extend(chosen.iter().map(|(label, _, image)| StripPanel {
-        label: format!("{label} ({:.3} relMSE)", rel_mse(&image.mean, reference)),
+        label: format!("{label} ({:.3} relMSE, last run at {budget} ms)", rel_mse(&image.mean, reference)),
         pixels: &image.mean,
     }));
     write_image_strip(path, width, height, &panels, inset)

@@ -60,7 +60,7 @@ pub fn info(args: InfoArgs) -> Result<()> {
 /// One line per kernel: SPIR-V bytes and milliseconds of GLSL compile, pipeline creation and
 /// first dispatch (where llvmpipe compiles).
 fn print_kernels(label: &str, reports: &[KernelCompile]) {
-    println!("kernels ({label}; compile stages in ms: GLSL, pipeline, first dispatch):");
+    println!("kernels ({label}; compile stages in ms: GLSL (0: from the SPIR-V cache), pipeline, first dispatch):");
     for k in reports {
         println!(
             "  {:<40} {:>8} B SPIR-V | {:>7.0} {:>7.0} {:>7.0} | total {:>7.0} ms",

@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::args::{DeviceArgs, PathArgs, SizeArgs};
 use super::reference_record::{scene_name, write_record, ReferenceRecord};
-use super::render_output::{create_parent, interrupt_flag, progress_bar};
+use super::render_output::{check_extension, create_parent, interrupt_flag, progress_bar};
 use super::{finish_device, load_with_warnings, open_device, scene_path};
 use restir_pt::image_io::write_exr;
 use restir_pt::reference_shard::{write_shard, ShardMeta, ShardSpec, ShardSums};
@@ -47,6 +47,10 @@ pub fn variance_path(out: &std::path::Path) -> PathBuf {
 
 pub fn reference(args: ReferenceArgs) -> Result<()> {
     let shard = args.shard.as_deref().map(ShardSpec::parse).transpose()?;
+    check_extension("--out", &args.out, "exr", "OpenEXR")?;
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
     let path = scene_path(Some(&args.scene));
     let scene = load_with_warnings(&path)?;
     let samples = shard.map(|s| s.samples(args.spp)).unwrap_or(0..args.spp);

@@ -10,8 +10,8 @@ use clap::{Args, ValueEnum};
 
 use super::args::{parse_exposure, DeviceArgs, PathArgs, RestirArgs, SceneArgs, Toggle};
 use super::render_output::{
-    compile_progress, create_parent, guard_nonfinite, interrupt_flag, print_compile_summary, progress_bar, Outputs, RenderReport,
-    RestirFrameReport,
+    check_extension, compile_progress, create_parent, guard_nonfinite, interrupt_flag, print_compile_summary, progress_bar, Outputs,
+    RenderReport, RestirFrameReport,
 };
 use super::{finish_device, load_with_options, open_device};
 use restir_pt::image_io::Exposure;
@@ -147,20 +147,31 @@ impl RenderArgs {
         if let Some(restir) = self.restir_settings() {
             restir.validate(self.path.max_depth)?;
         }
-        self.check_outputs_differ()
+        self.check_output_names()
     }
 
     /// The EXR (--out) and its PNG preview (--png, default --out with a .png extension) must be
     /// two files: with `--out image.png` the preview would overwrite the linear image.
-    fn check_outputs_differ(&self) -> Result<()> {
+    /// Each file is named for its format (--out and --variance OpenEXR, --png PNG).
+    fn check_output_names(&self) -> Result<()> {
         if let Some(out) = &self.out {
             let png = self.png.clone().unwrap_or_else(|| out.with_extension("png"));
             if &png == out {
+                if self.png.is_some() {
+                    bail!("--png {}: the same file as --out; give the preview another name", png.display());
+                }
                 bail!(
                     "--out {}: the image is written as OpenEXR and its PNG preview would overwrite it; give --out an .exr name (the preview goes beside it) or --png another file",
                     out.display()
                 );
             }
+            check_extension("--out", out, "exr", "OpenEXR")?;
+        }
+        if let Some(png) = &self.png {
+            check_extension("--png", png, "png", "PNG")?;
+        }
+        if let Some(variance) = &self.variance {
+            check_extension("--variance", variance, "exr", "OpenEXR")?;
         }
         Ok(())
     }
@@ -336,7 +347,12 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if let Some(r) = &args.report {
         report.write(r)?;
     }
-    eprintln!("wrote {} and {}", paths.out.display(), paths.png.display());
+    let written: Vec<String> = [Some(&paths.out), Some(&paths.png), args.variance.as_ref(), args.report.as_ref()]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    eprintln!("wrote {}", written.join(", "));
     Ok(())
 }
 

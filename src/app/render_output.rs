@@ -113,7 +113,7 @@ impl RestirFrameReport {
     pub fn summary(&self) -> String {
         let passes: Vec<String> = self.pass_ms.iter().map(|(n, t)| format!("{n} {t:.1}")).collect();
         let shifts = match (self.traversals_per_shift, self.shift_lane_use) {
-            (Some(rays), Some(lanes)) => format!(", {rays:.2} rays per shift, lanes busy in shifts {:.0}%", 100.0 * lanes),
+            (Some(rays), Some(lanes)) => format!(", {rays:.2} traversals per shift, lanes busy in shifts {:.0}%", 100.0 * lanes),
             _ => String::new(),
         };
         format!(
@@ -226,6 +226,20 @@ pub fn interrupt_flag() -> Arc<AtomicBool> {
         flag
     })
     .clone()
+}
+
+/// Refuses an output file `path` (given with `flag`) whose extension is not `ext` (compared
+/// without case): the file is written as `format` whatever its name, and a misnamed file
+/// misleads every program that opens it later.
+pub fn check_extension(flag: &str, path: &Path, ext: &str, format: &str) -> Result<()> {
+    let matches = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if !matches {
+        anyhow::bail!("{flag} {}: the file is written as {format}; give it a .{ext} name", path.display());
+    }
+    Ok(())
 }
 
 /// Creates the folder `file` goes into, with a note on stderr when it did not exist (a mistyped

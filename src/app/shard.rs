@@ -28,6 +28,7 @@ pub struct MergeArgs {
 
 pub fn merge(args: MergeArgs) -> Result<()> {
     let (out, allow_nonfinite) = (args.out.as_path(), args.allow_nonfinite);
+    super::render_output::check_extension("--out", out, "exr", "OpenEXR")?;
     let (merged, missing) = merge_shards(&args.shards)?;
     let meta = &merged.meta;
     if !missing.is_empty() {

@@ -80,7 +80,7 @@ impl RenderSettings {
     pub fn validate_numbers(&self) -> Result<()> {
         let (w, h) = (self.width, self.height);
         if w == 0 || h == 0 {
-            bail!("resolution {w}x{h} is empty: width and height must be at least 1");
+            bail!("resolution {w}x{h} is empty: --width and --height must be at least 1");
         }
         if w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE || w as u64 * h as u64 > MAX_PIXELS {
             bail!("resolution {w}x{h} is too large: at most {MAX_IMAGE_SIDE} per side and {MAX_PIXELS} pixels");

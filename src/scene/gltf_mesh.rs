@@ -237,6 +237,22 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// Whether `accessor`'s `count` elements lie within its buffer view, and the view within its
+    /// loaded buffer (glTF 2.0 §5.1.1 and §3.6.2.4: offset + stride × (count − 1) + element size ≤
+    /// the view's byteLength). A sparse accessor without a view has nothing to check here.
+    fn accessor_fits(&self, accessor: &gltf::Accessor) -> bool {
+        let Some(view) = accessor.view() else { return true };
+        let element = accessor.size();
+        let stride = view.stride().unwrap_or(element);
+        let Some(before_last) = accessor.count().checked_sub(1) else {
+            return false;
+        };
+        let last = before_last as u64 * stride as u64 + element as u64;
+        let in_view = accessor.offset() as u64 + last <= view.length() as u64;
+        let buffer_len = self.buffers.get(view.buffer().index()).map_or(0, |d| d.0.len());
+        in_view && (view.offset() + view.length()) as u64 <= buffer_len as u64
+    }
+
     /// The spec's accessor counts (at least 1) and types for positions (float VEC3), indices
     /// (unsigned SCALAR) and colours; the gltf crate's readers assume them (an index accessor of
     /// floats hits `unreachable!`, a count of 0 overflows).
@@ -253,6 +269,22 @@ impl Loader<'_> {
                 bail!(problem(
                     self.path,
                     format!("mesh {}: the {name} accessor has count 0", mesh.index())
+                ));
+            }
+        }
+        // The gltf crate's readers return None for data that does not fit, and an index reader
+        // of None reads as "no indices": an oversized accessor would draw the vertices in order.
+        let used = prim.indices().map(|a| ("indices".to_string(), a)).into_iter();
+        for (name, accessor) in used.chain(prim.attributes().map(|(s, a)| (s.to_string(), a))) {
+            if !self.accessor_fits(&accessor) {
+                bail!(problem(
+                    self.path,
+                    format!(
+                        "mesh {}: the {name} accessor ({}, count {}) does not fit its buffer view or buffer",
+                        mesh.index(),
+                        accessor.index(),
+                        accessor.count()
+                    )
                 ));
             }
         }

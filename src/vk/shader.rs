@@ -1,10 +1,12 @@
 //! GLSL to SPIR-V with shaderc (glslang), resolving `#include` against the embedded glsl/ tree.
 
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::{Mutex, OnceLock};
 
 use anyhow::{anyhow, Result};
 
+use super::spirv_cache;
 use crate::shader_interface::{glsl_header, GLSL_HEADER_NAME};
 
 /// Every file under glsl/, keyed by its path relative to glsl/.
@@ -48,7 +50,8 @@ fn resolve_include(requested: &str, kind: shaderc::IncludeType, requester: &str)
 type CacheKey = (String, Vec<(String, String)>);
 
 /// Compiles the compute kernel `name` (a path under glsl/) with the given `#define`s.
-/// Results are cached for the process: tests build the same kernels many times.
+/// Results are kept for the process (tests build the same kernels many times) and on disk
+/// across processes (`spirv_cache`).
 pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
     static CACHE: OnceLock<Mutex<HashMap<CacheKey, Vec<u32>>>> = OnceLock::new();
     let key = (
@@ -59,6 +62,31 @@ pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> 
     if let Some(spirv) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
         return Ok(spirv);
     }
+    let spirv = match spirv_cache::cache_dir() {
+        Some(dir) => compile_kernel_cached_in(name, defines, &dir)?.0,
+        None => compile_glsl(name, defines)?,
+    };
+    if let Ok(mut c) = cache.lock() {
+        c.insert(key, spirv.clone());
+    }
+    Ok(spirv)
+}
+
+/// `compile_kernel` through the on-disk cache in `dir` alone: the SPIR-V, and whether it came
+/// from the cache.
+pub fn compile_kernel_cached_in(name: &str, defines: &[(&str, &str)], dir: &Path) -> Result<(Vec<u32>, bool)> {
+    let key = spirv_cache::cache_key(name, defines);
+    if let Some(spirv) = spirv_cache::load(dir, &key) {
+        return Ok((spirv, true));
+    }
+    let spirv = compile_glsl(name, defines)?;
+    spirv_cache::store(dir, &key, &spirv);
+    Ok((spirv, false))
+}
+
+/// GLSL to SPIR-V with shaderc: Vulkan 1.2, SPIR-V 1.5, optimised, with debug information
+/// (names for the validation layer's messages and for `reflect`).
+fn compile_glsl(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
     let source = glsl_source(name).ok_or_else(|| anyhow!("no GLSL kernel named {name} under glsl/"))?;
     let compiler = shaderc::Compiler::new().map_err(|e| anyhow!("cannot initialise shaderc: {e}"))?;
     let mut options = shaderc::CompileOptions::new().map_err(|e| anyhow!("cannot create shaderc options: {e}"))?;
@@ -80,9 +108,5 @@ pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> 
     let artifact = compiler
         .compile_into_spirv(source, shaderc::ShaderKind::Compute, name, "main", Some(&options))
         .map_err(|e| anyhow!("GLSL compilation of {name} failed:\n{e}"))?;
-    let spirv = artifact.as_binary().to_vec();
-    if let Ok(mut c) = cache.lock() {
-        c.insert(key, spirv.clone());
-    }
-    Ok(spirv)
+    Ok(artifact.as_binary().to_vec())
 }

@@ -104,7 +104,8 @@ fn cli_bad_input_fails_with_one_clear_line() {
     assert_clean_failure(&["render", broken.to_str().unwrap()], &["broken.gltf", "invalid glTF"]);
     let truncated = temp_file("truncated.glb", b"glTF\x02\x00\x00\x00\xff\x00\x00\x00");
     assert_clean_failure(&["info", truncated.to_str().unwrap()], &["truncated.glb"]);
-    assert_clean_failure(&["render", "--width", "0"], &["resolution 0x256"]);
+    assert_clean_failure(&["render", "--width", "0"], &["resolution 0x256", "--width"]);
+    assert_clean_failure(&["bench", "--runs", "0", "--width", "8", "--height", "8"], &["--runs"]);
     assert_clean_failure(&["render", "--width", "100000", "--height", "100000"], &["too large"]);
     assert_clean_failure(&["render", "--method", "pt", "--spp", "0"], &["--spp"]);
     assert_clean_failure(&["render", "--max-depth", "0"], &["--max-depth"]);
@@ -124,6 +125,11 @@ fn cli_bad_input_fails_before_the_device_opens() {
         &["render", "--width", "100000", "--height", "100000"],
         &["render", "--method", "pt", "--spp", "0"],
         &["render", "--max-depth", "0"],
+        &["render", "--out", "a.exr", "--png", "a.jpg"],
+        &["render", "--out", "a.exr", "--png", "a.exr"],
+        &["render", "--out", "a.jpg"],
+        &["reference", "scenes/cornell.gltf", "--spp", "4", "--out", "r.png"],
+        &["reference", "scenes/cornell.gltf", "--spp", "0", "--out", "r.exr"],
         &["render", "--spatial", "9"],
     ] {
         assert_clean_failure(args, &[]);
@@ -238,7 +244,10 @@ fn cli_restir_render_prints_passes_and_failed_shifts() {
     let lanes = json["restir"]["shift_lane_use"].as_f64().unwrap();
     assert!((1.0..10.0).contains(&rays), "rays per shift {rays}");
     assert!(lanes > 0.0 && lanes <= 1.0, "lanes busy in shifts {lanes}");
-    assert!(last.contains("rays per shift") && last.contains("lanes busy in shifts"), "{last}");
+    assert!(
+        last.contains("traversals per shift") && last.contains("lanes busy in shifts"),
+        "{last}"
+    );
     assert!(exr.exists());
     assert_clean_failure(&["render", "--max-depth", "8"], &["--max-depth 8", "at most 7"]);
     assert_clean_failure(&["render", "--spatial", "9"], &["--spatial 9"]);

@@ -192,3 +192,28 @@ fn cli_out_into_a_missing_folder_creates_it_with_a_note() {
     let folder = out.parent().unwrap().display().to_string();
     assert!(stderr.contains(&format!("note: created the folder {folder}")), "{stderr}");
 }
+
+/// Each output file is named for the format written into it, and the error names the option at
+/// fault.
+#[test]
+fn cli_output_names_must_match_their_formats() {
+    assert_clean_failure(
+        &["render", "--out", "a.exr", "--png", "a.jpg"],
+        &["--png a.jpg", "PNG", ".png name"],
+    );
+    assert_clean_failure(
+        &["render", "--out", "a.exr", "--png", "a.exr"],
+        &["--png a.exr", "same file as --out"],
+    );
+    assert_clean_failure(&["render", "--out", "a.jpg"], &["--out a.jpg", "OpenEXR", ".exr name"]);
+    assert_clean_failure(&["render", "--variance", "v.png"], &["--variance v.png", ".exr name"]);
+    assert_clean_failure(
+        &["reference", "scenes/cornell.gltf", "--spp", "4", "--out", "r.png"],
+        &["--out r.png", "OpenEXR"],
+    );
+    assert_clean_failure(&["merge", "a.exr", "--out", "m.png"], &["--out m.png", "OpenEXR"]);
+    assert_clean_failure(
+        &["reference", "scenes/cornell.gltf", "--spp", "0", "--out", "r.exr"],
+        &["--spp must be at least 1"],
+    );
+}

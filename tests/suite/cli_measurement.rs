@@ -242,6 +242,23 @@ fn cli_compare_refuses_a_reference_of_another_camera() {
         (Some(0), Some("cornell.gltf"))
     );
     let out = dir.join("cmp");
+    // A record of another size beside the image: the two do not belong together.
+    let mismatched = dir.join("mismatched.exr");
+    std::fs::copy(&reference, &mismatched).unwrap();
+    let mut wrong = record.clone();
+    wrong["width"] = serde_json::json!(64);
+    std::fs::write(dir.join("mismatched.json"), wrong.to_string()).unwrap();
+    assert_clean_failure(
+        &[
+            "compare",
+            "scenes/cornell.gltf",
+            "--reference",
+            mismatched.to_str().unwrap(),
+            "--out-dir",
+            out.to_str().unwrap(),
+        ],
+        &["mismatched.exr", "8x8", "64x8", "record"],
+    );
     assert_clean_failure(
         &[
             "compare",

@@ -43,6 +43,7 @@ mod shift;
 mod shift_oracle;
 mod specular_layer;
 mod speed_accuracy;
+mod spirv_cache;
 mod statistics;
 mod surface_oracle;
 mod sweeps;
