@@ -9,33 +9,82 @@ use ash::vk;
 pub enum GpuError {
     /// VK_ERROR_DEVICE_LOST: the device and everything made on it are unusable.
     #[error("the Vulkan device was lost (VK_ERROR_DEVICE_LOST) during {during}; the GPU work was abandoned")]
-    DeviceLost { during: &'static str },
+    DeviceLost {
+        /// The operation that was running, e.g. "waiting for GPU work".
+        during: &'static str,
+    },
     /// A submission's fence did not signal within `seconds`.
     #[error("a GPU submission did not finish within {seconds} s; the device is considered hung")]
-    Timeout { seconds: u64 },
+    Timeout {
+        /// The wait that ran out, in seconds.
+        seconds: u64,
+    },
     /// Device or host memory ran out (`bytes` is 0 when Vulkan did not say how much).
     #[error("out of GPU memory while allocating {what} ({bytes} bytes)")]
-    OutOfMemory { what: String, bytes: u64 },
+    OutOfMemory {
+        /// The buffer or operation being allocated.
+        what: String,
+        /// The requested size in bytes; 0 when unknown.
+        bytes: u64,
+    },
     /// The allocator refused for another reason than memory (no compatible memory type, a
     /// failed map, an internal error): gpu-allocator's `AllocationError` other than `OutOfMemory`.
     #[error("the GPU memory allocator could not allocate {what} ({bytes} bytes): {reason}")]
-    Allocation { what: String, bytes: u64, reason: String },
+    Allocation {
+        /// The buffer being allocated.
+        what: String,
+        /// The requested size in bytes.
+        bytes: u64,
+        /// gpu-allocator's message.
+        reason: String,
+    },
     /// A buffer larger than one storage-buffer binding may be.
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per storage-buffer binding (maxStorageBufferRange)")]
-    BindingTooLarge { what: String, needed: u64, limit: u64 },
+    BindingTooLarge {
+        /// The buffer that does not fit.
+        what: String,
+        /// Its size in bytes.
+        needed: u64,
+        /// The device's maxStorageBufferRange in bytes.
+        limit: u64,
+    },
     /// A buffer larger than one allocation may be.
     #[error("{what} needs {needed} bytes but the device allows at most {limit} bytes per allocation (maxMemoryAllocationSize)")]
-    AllocationTooLarge { what: String, needed: u64, limit: u64 },
+    AllocationTooLarge {
+        /// The buffer that does not fit.
+        what: String,
+        /// Its size in bytes.
+        needed: u64,
+        /// The device's maxMemoryAllocationSize in bytes.
+        limit: u64,
+    },
     /// Any other failed Vulkan call, with its result code.
     #[error("Vulkan call failed during {during}: {result:?}")]
-    Vulkan { during: &'static str, result: vk::Result },
+    Vulkan {
+        /// The operation that failed.
+        during: &'static str,
+        /// The call's result code.
+        result: vk::Result,
+    },
     /// Kernels count their loop iterations against the driver's budget (`limit` per loop and
     /// invocation); `groups` subgroups ran out, having counted about `counted`.
     #[error("{groups} subgroup(s) of a dispatch ran out of the driver's loop budget ({limit} iterations per loop and shader invocation; about {counted} counted), which truncates paths: the render was stopped rather than written wrong")]
-    LoopLimit { limit: u32, counted: u32, groups: u32 },
+    LoopLimit {
+        /// The driver's loop iteration budget per loop and invocation (0 if unknown).
+        limit: u32,
+        /// The most iterations a subgroup counted in one guarded loop.
+        counted: u32,
+        /// Subgroups of the dispatch whose loop was cut short.
+        groups: u32,
+    },
     /// The validation layer (`ContextOptions::validation`) reported `count` messages.
     #[error("{count} Vulkan validation error(s) were reported; first: {first}")]
-    Validation { count: u32, first: String },
+    Validation {
+        /// Error and warning messages reported since the context was made.
+        count: u32,
+        /// The first message's text.
+        first: String,
+    },
 }
 
 /// Maps a raw Vulkan result to a typed error, keeping device loss and OOM distinguishable.

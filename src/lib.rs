@@ -45,6 +45,9 @@
 //! [`error::GpuError`] inside them. The shading code exists twice: every GLSL function an
 //! oracle test mirrors has a Rust twin of the same name in [`shading`] (or [`scene::bvh`]).
 
+// Every public item carries a doc comment (units, spaces, layouts, errors, sources): a new
+// undocumented one fails the build, clippy and rustdoc alike.
+#![deny(missing_docs)]
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 

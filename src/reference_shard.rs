@@ -55,8 +55,9 @@ impl ShardSpec {
 pub struct ShardMeta {
     /// The scene file as given to `reference`.
     pub scene: String,
-    /// Image size in pixels.
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// The longest path, in segments (`RenderSettings::max_depth`).
     pub max_depth: u32,
@@ -66,11 +67,13 @@ pub struct ShardMeta {
     pub seed: u32,
     /// Samples per pixel of the whole reference.
     pub total_spp: u32,
-    /// This shard's index and the number of shards (`ShardSpec`).
+    /// This shard's index, 0-based (`ShardSpec`).
     pub shard: u32,
+    /// The number of shards the reference is split into.
     pub shards: u32,
-    /// This shard's samples: indices `first_sample .. first_sample + spp`.
+    /// This shard's first sample index: it holds samples `first_sample .. first_sample + spp`.
     pub first_sample: u32,
+    /// This shard's samples per pixel.
     pub spp: u32,
 }
 
@@ -88,6 +91,7 @@ impl ShardMeta {
 
 /// Per-pixel accumulations, row-major: `[sum r, sum g, sum b, count]` and `[sum r^2, g^2, b^2, 0]`.
 pub struct ShardSums {
+    /// What the shard was rendered with.
     pub meta: ShardMeta,
     /// `width * height` pixels of radiance sums and sample counts.
     pub sums: Vec<[f32; 4]>,

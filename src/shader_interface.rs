@@ -69,8 +69,12 @@ binding_family! {
     SceneBinding, "SCENE_BINDING_", set 0 {
         /// `gpu_types::FrameParams`, a host-written storage buffer.
         FrameParams = 0,
+        /// `gpu_types::Triangle` array in BVH leaf order (or, addressed, its device address and
+        /// length).
         Triangles = 1,
+        /// `gpu_types::BvhNode` array, depth-first with skip links (or its address and length).
         Nodes = 2,
+        /// `gpu_types::Material` array, indexed by `Triangle::material`.
         Materials = 3,
         /// Emissive triangles, punctual lights and the environment map's rows.
         Emitters = 4,
@@ -96,13 +100,21 @@ binding_family! {
     RestirBinding, "RESTIR_BINDING_", set 0 {
         /// `gpu_types::ReuseParams`, host-written, with the frame's pass table.
         ReuseParams = 5,
+        /// Surface slot 0: one `gpu_types::Surface` per pixel.
         Surfaces0 = 6,
+        /// Surface slot 1: one `gpu_types::Surface` per pixel.
         Surfaces1 = 7,
+        /// Reservoir slot 0, first halves: one `gpu_types::ReservoirHead` per reservoir.
         ReservoirHeads0 = 8,
+        /// Reservoir slot 0, second halves: one `gpu_types::ReservoirTail` per reservoir.
         ReservoirTails0 = 9,
+        /// Reservoir slot 1, first halves.
         ReservoirHeads1 = 10,
+        /// Reservoir slot 1, second halves.
         ReservoirTails1 = 11,
+        /// Reservoir slot 2, first halves.
         ReservoirHeads2 = 12,
+        /// Reservoir slot 2, second halves.
         ReservoirTails2 = 13,
         /// Per reservoir vec4: the emission seen directly (w: frames in its running mean).
         Direct = 14,

@@ -11,12 +11,19 @@ pub use crate::shader_interface::COUNTER_COUNT;
 pub struct TraversalCounters {
     /// Calls of a traversal (`trace_pair`: one per path step, for up to two rays).
     pub traversals: u64,
+    /// BVH nodes whose box a lane tested.
     pub node_visits: u64,
+    /// Ray-triangle tests a lane ran.
     pub triangle_tests: u64,
+    /// Path steps (bounces) a lane ran.
     pub path_steps: u64,
+    /// Iterations of the node loop, once per subgroup.
     pub node_iterations: u64,
+    /// Iterations of the triangle loop, once per subgroup.
     pub triangle_iterations: u64,
+    /// Iterations of the path-step loop, once per subgroup.
     pub step_iterations: u64,
+    /// Lanes per subgroup on the device that counted.
     pub subgroup_size: u32,
 }
 
@@ -36,6 +43,7 @@ impl TraversalCounters {
         }
     }
 
+    /// Adds `o`'s counts to these (a render's dispatches summed); the subgroup size becomes `o`'s.
     pub fn add(&mut self, o: &Self) {
         self.traversals += o.traversals;
         self.node_visits += o.node_visits;

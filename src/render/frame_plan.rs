@@ -7,12 +7,16 @@ use crate::gpu_types::{RestirPass, RESTIR_MAX_PASSES};
 /// The kernels of a frame (glsl/restir_*.comp).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PassKernel {
+    /// Initial candidates: traces each pixel's candidate paths and resamples them into a
+    /// reservoir (glsl/restir_initial.comp).
     Initial,
     /// Temporal reuse with shifts, for a moved camera.
     Temporal,
     /// Temporal reuse of an unmoved camera, compiled without shift code.
     TemporalUnmoved,
+    /// One round of spatial reuse from neighbouring pixels (glsl/restir_spatial.comp).
     Spatial,
+    /// Shades the final reservoirs and accumulates the frame (glsl/restir_shade.comp).
     Shade,
 }
 
@@ -53,7 +57,7 @@ pub const PASS_NAMES: [&str; 4] = ["initial", "temporal", "spatial", "shade"];
 
 /// What a frame starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct FrameState {
+pub(crate) struct FrameState {
     /// The slot holding the previous frame's final reservoirs, if there was a previous frame.
     pub history_slot: Option<u32>,
     /// Temporal reuse is on.
@@ -82,15 +86,20 @@ pub enum History {
 
 /// One dispatch of a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PlannedPass {
+pub(crate) struct PlannedPass {
+    /// The kernel dispatched.
     pub kernel: PassKernel,
+    /// Its entry of the pass table: the reservoir and surface slots it reads and writes, and
+    /// its random-number key.
     pub slots: RestirPass,
 }
 
 /// A frame's dispatches, and the slot of the reservoirs the next frame's temporal reuse reads.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FramePlan {
+pub(crate) struct FramePlan {
+    /// The dispatches in order (at most `RESTIR_MAX_PASSES`).
     pub passes: Vec<PlannedPass>,
+    /// The reservoir slot (0-2) the next frame's temporal reuse reads ([`History`] decides which).
     pub final_slot: u32,
 }
 
@@ -101,7 +110,7 @@ const SPATIAL_SEED: u32 = 0x5bd1_e995;
 /// the spatial rounds, then shading of the last result. The history's slot is never written
 /// before the temporal pass has read it; with `History::Temporal` the spatial rounds alternate
 /// between the two slots other than the one they start from, which stays the next history.
-pub fn plan_frame(state: &FrameState) -> FramePlan {
+pub(crate) fn plan_frame(state: &FrameState) -> FramePlan {
     // The previous frame's result keeps its slot; the passes alternate between the other two.
     let prev_slot = state.history_slot.unwrap_or(RESERVOIR_SLOTS as u32 - 1);
     let work: Vec<u32> = (0..RESERVOIR_SLOTS as u32).filter(|&s| s != prev_slot).collect();
@@ -159,7 +168,7 @@ pub fn plan_frame(state: &FrameState) -> FramePlan {
 }
 
 /// The pass table of ReuseParams: the plan's slots in dispatch order, unused entries zero.
-pub fn pass_table(plan: &FramePlan) -> [RestirPass; RESTIR_MAX_PASSES] {
+pub(crate) fn pass_table(plan: &FramePlan) -> [RestirPass; RESTIR_MAX_PASSES] {
     let mut table = [RestirPass::default(); RESTIR_MAX_PASSES];
     for (entry, pass) in table.iter_mut().zip(&plan.passes) {
         *entry = pass.slots;

@@ -5,8 +5,9 @@ use glam::Vec3;
 /// A rendered image: `width * height` pixels, row-major from the top left, linear RGB radiance.
 #[derive(Debug, Clone)]
 pub struct Image {
-    /// Size in pixels.
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// The pixel estimates (the mean of their samples).
     pub mean: Vec<Vec3>,

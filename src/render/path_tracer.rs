@@ -31,9 +31,14 @@ const STATUS_WORDS: u64 = 5 + 2 * COUNTER_COUNT as u64;
 const COUNTER_WORDS_START: usize = 4;
 const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
+/// What one [`PathTracer::render`] call did and how long it took.
 pub struct RenderStats {
+    /// Samples per pixel accumulated so far, over every call since the tracer was built or reset.
     pub spp: u32,
+    /// Milliseconds of GPU time of this call's dispatches, by timestamp queries; where the device
+    /// has none, each submission's wall time instead.
     pub gpu_ms: f64,
+    /// Wall-clock milliseconds of the call, submissions and waits included.
     pub wall_ms: f64,
     /// Paths whose radiance or throughput was NaN or infinite (counted on the GPU); each one
     /// makes its pixel non-finite.
@@ -45,6 +50,8 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
+    /// Throughput: `pixels * spp` paths over `gpu_ms` (over `wall_ms` if no GPU time was
+    /// measured), in paths per second.
     pub fn paths_per_second(&self, pixels: usize) -> f64 {
         let ms = if self.gpu_ms > 0.0 { self.gpu_ms } else { self.wall_ms };
         pixels as f64 * self.spp as f64 / (ms * 1e-3)

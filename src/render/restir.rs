@@ -30,15 +30,20 @@ const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 /// per vertex a 32-byte vertex, a lobe and a 16-byte weight row.
 const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
 
-/// GPU milliseconds per pass of one frame (indexed like PASS_NAMES); None without timestamps.
+/// What one ReSTIR PT frame ([`Restir::frame`]) took, and its counters.
 #[derive(Debug, Clone)]
 pub struct FrameStats {
+    /// GPU milliseconds per pass, indexed like [`PASS_NAMES`] (initial, temporal, spatial, shade;
+    /// about 0 for a pass the frame did not run); `None` where the device has no timestamp queries.
     pub pass_ms: Option<[f64; 4]>,
+    /// Wall-clock milliseconds of the frame, parameter upload and counter readback included.
     pub wall_ms: f64,
+    /// The kernels' counters for this frame (shifts, dropped candidates, non-finite values).
     pub counters: RestirStats,
 }
 
 impl FrameStats {
+    /// Sum of `pass_ms`: the frame's GPU time in milliseconds, if measured.
     pub fn gpu_ms(&self) -> Option<f64> {
         self.pass_ms.map(|p| p.iter().sum())
     }

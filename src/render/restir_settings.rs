@@ -10,8 +10,16 @@ use crate::shading::path_record::MAX_PATH_LENGTH;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 #[repr(u32)]
 pub enum ShiftKind {
+    /// Reconnection shift: the offset path keeps its own primary hit y1 and connects it to the
+    /// base path's x2, keeping x2..xk; defined only where the base reconnects at r = 2
+    /// (docs/shift-mappings.md).
     Reconnection = 0,
+    /// Random replay: the offset path is traced anew from y1 with the base path's random numbers;
+    /// its Jacobian is 1.
     Replay = 1,
+    /// Hybrid shift (Lin et al. 2022; the default): random replay of y2..y_{r-1}, then a
+    /// reconnection to the base path's x_r; random replay alone where the base has no
+    /// reconnection vertex.
     Hybrid = 2,
 }
 
@@ -28,6 +36,7 @@ pub enum ReuseMis {
 }
 
 impl ShiftKind {
+    /// Every shift, in discriminant order.
     pub const ALL: [ShiftKind; 3] = [ShiftKind::Reconnection, ShiftKind::Replay, ShiftKind::Hybrid];
 
     /// The kind called `name` (`reconnection`, `replay` or `hybrid`).
@@ -35,6 +44,7 @@ impl ShiftKind {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
 
+    /// The CLI name: `reconnection`, `replay` or `hybrid`.
     pub fn name(self) -> &'static str {
         match self {
             ShiftKind::Reconnection => "reconnection",
@@ -54,6 +64,7 @@ impl ShiftKind {
 }
 
 impl ReuseMis {
+    /// Every MIS, in discriminant order.
     pub const ALL: [ReuseMis; 2] = [ReuseMis::GeneralizedBalance, ReuseMis::Pairwise];
 
     /// The MIS called `name` (`gbh` or `pairwise`).
@@ -61,6 +72,7 @@ impl ReuseMis {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
+    /// The CLI name: `gbh` or `pairwise`.
     pub fn name(self) -> &'static str {
         match self {
             ReuseMis::GeneralizedBalance => "gbh",
@@ -78,14 +90,23 @@ impl ReuseMis {
 }
 
 pub use crate::shader_interface::{MAX_NEIGHBOURS, MAX_SPATIAL_ROUNDS as MAX_ROUNDS};
+/// The most initial candidates per reservoir that [`RestirSettings::validate`] accepts.
 pub const MAX_CANDIDATES: u32 = 64;
+/// The most emission rays per pixel that [`RestirSettings::validate`] accepts.
 pub const MAX_EMISSION_RAYS: u32 = 64;
+/// The most reservoirs per pixel that [`RestirSettings::validate`] accepts.
 pub const MAX_RESERVOIRS: u32 = 16;
 
+/// The ReSTIR PT options (Lin et al. 2022, on the reservoir reuse of Bitterli et al. 2020). Check
+/// them with [`RestirSettings::validate`] before building a [`super::Restir`]. Fields whose
+/// default was measured say where (docs/lab-notebook.md).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RestirSettings {
+    /// The shift mapping of temporal and spatial reuse.
     pub shift: ShiftKind,
+    /// The resampling MIS weights of reuse.
     pub mis: ReuseMis,
+    /// Whether each frame reuses the previous frame's reservoirs.
     pub temporal: bool,
     /// Spatial neighbours per round; 0 turns spatial reuse off. The default, 1, is the cheapest
     /// spatial reuse: two shifts per pixel under either MIS (k neighbours cost k (k + 1) under
@@ -97,6 +118,7 @@ pub struct RestirSettings {
     /// (docs/lab-notebook.md, "Spatial reuse that pays"); a nearer neighbour passes the surface
     /// similarity test more often.
     pub radius: f32,
+    /// Spatial reuse rounds per frame, 1 to `MAX_ROUNDS` (ignored when `spatial` is 0).
     pub rounds: u32,
     /// The temporal input's confidence is capped at m_cap times the current M.
     pub m_cap: f32,
@@ -115,7 +137,11 @@ pub struct RestirSettings {
     /// Which reservoirs the next frame's temporal reuse reads: those before spatial reuse or
     /// after it (docs/restir.md, "Which reservoirs are the history").
     pub history: History,
+    /// Spatial neighbours need |dot(n, n')| of their primary hits' geometric normals at least
+    /// this (default 0.9).
     pub normal_threshold: f32,
+    /// Spatial neighbours need their depth to agree within this fraction (default 0.1; see
+    /// [`crate::gpu_types::ReuseParams::depth_threshold`]).
     pub depth_threshold: f32,
 }
 
@@ -140,6 +166,8 @@ impl Default for RestirSettings {
 }
 
 impl RestirSettings {
+    /// Checks every option against its range and `max_depth` (the render's) against the path
+    /// record's [`MAX_PATH_LENGTH`]. Errors: one line naming the CLI flag and the allowed range.
     pub fn validate(&self, max_depth: u32) -> Result<()> {
         if max_depth as usize > MAX_PATH_LENGTH {
             bail!("--max-depth {max_depth} is too deep for ReSTIR PT: its path records hold at most {MAX_PATH_LENGTH} segments");

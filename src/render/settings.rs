@@ -10,14 +10,17 @@ use super::SceneInfo;
 /// Sides beyond this are refused: per-pixel indices stay far inside u32, and 8x8 workgroups
 /// stay within 8192 per axis, below the 65535 every Vulkan device supports.
 pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
+/// The most pixels an image may have (2²⁶, e.g. 8192 × 8192); [`RenderSettings::validate`]
+/// refuses more before any GPU allocation.
 pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// What both renderers share: image, path length, randomness and camera. Check it with
 /// [`RenderSettings::validate`] before building a renderer.
 #[derive(Debug, Clone)]
 pub struct RenderSettings {
-    /// Image size in pixels (at most [`MAX_IMAGE_SIDE`] per side and [`MAX_PIXELS`] in all).
+    /// Image width in pixels (at most [`MAX_IMAGE_SIDE`] per side and [`MAX_PIXELS`] in all).
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// The path tracer's samples per pixel; ReSTIR PT ignores it.
     pub spp: u32,
@@ -46,7 +49,9 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// Image width in pixels when none is asked for.
     pub const DEFAULT_WIDTH: u32 = 256;
+    /// Image height in pixels when none is asked for.
     pub const DEFAULT_HEIGHT: u32 = 256;
     /// Paths per pixel of a path-traced image.
     pub const DEFAULT_SPP: u32 = 64;

@@ -12,6 +12,8 @@ use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, Context};
 /// Set 1's buffers: the per-triangle attributes, then (with textures) the material texture
 /// table, the texture headers and the texels.
 pub struct SurfaceGpu {
+    /// The set's storage buffers in binding order (glsl/surface_bindings.glsl): one without
+    /// textures, four with them.
     pub buffers: Vec<Buffer>,
     /// Bytes uploaded for textures (texels, headers, material table).
     pub texture_bytes: usize,

@@ -7,11 +7,15 @@ use glam::Vec3;
 
 use crate::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
+/// One bundled scene: its file under scenes/ and the recipe that writes it.
 pub struct BundledScene {
+    /// The file name in scenes/, e.g. "cornell.gltf".
     pub file_name: &'static str,
+    /// Produces the file's complete glTF text, byte-for-byte what is committed.
     pub build: fn() -> String,
 }
 
+/// Every bundled scene, in the order scenes/README.md lists them.
 pub const BUNDLED_SCENES: &[BundledScene] = &[
     BundledScene {
         file_name: "cornell.gltf",

@@ -7,6 +7,7 @@ use crate::gpu_types::{BvhNode, Triangle, LEAF_COUNT_BITS, LEAF_COUNT_MASK};
 use crate::shading::alpha::AlphaScene;
 use crate::shading::ray_offset::offset_ray_origin;
 
+/// The triangle index of a miss (and of an escaped path vertex); shared with glsl/bvh.glsl.
 pub const NO_HIT: u32 = u32::MAX;
 const SAH_BINS: usize = 16;
 const MAX_LEAF_TRIANGLES: usize = 4;
@@ -16,10 +17,14 @@ const MAX_SAH_LEAF_TRIANGLES: usize = 12;
 const SAH_MAX_DEPTH: usize = 40;
 const _: () = assert!(MAX_SAH_LEAF_TRIANGLES as u32 <= LEAF_COUNT_MASK);
 
+/// A ray's hit (twin of GLSL `Hit`, glsl/bvh.glsl).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
+    /// Ray parameter of the hit: distance along the ray in units of |d| (scene units for a unit d).
     pub t: f32,
+    /// Index of the triangle hit (in the scene's BVH leaf order), or [`NO_HIT`].
     pub triangle: u32,
+    /// Barycentrics (b1, b2) of the hit on the triangle, weights of vertices 1 and 2.
     pub bary: Vec2,
 }
 
@@ -50,6 +55,8 @@ impl Aabb {
 
 /// A BVH over `triangles`, which the build reorders so that leaves index them contiguously.
 pub struct Bvh {
+    /// The nodes in depth-first order with skip links (see [`BvhNode`]); node 0 is the root.
+    /// Leaves index triangles in the reordered sequence `order` describes.
     pub nodes: Vec<BvhNode>,
     /// `order[i]` is the input index of the triangle now at position i.
     pub order: Vec<u32>,
@@ -63,6 +70,10 @@ struct Builder<'a> {
 }
 
 impl Bvh {
+    /// Builds the BVH over `triangles` with the binned surface area heuristic (16 bins; pbrt-v4
+    /// `BVHAggregate` with SAH), falling back to the object median past depth 40. The input is
+    /// left as it is: the caller reorders its triangles by `order`. An empty input gives one
+    /// empty leaf.
     pub fn build(triangles: &[Triangle]) -> Bvh {
         let bounds: Vec<Aabb> = triangles
             .iter()
@@ -219,6 +230,9 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, tri: &Triangle, tmax: f32) -> Option
     (t > 0.0 && t < tmax).then_some((t, Vec2::new(b1, b2)))
 }
 
+/// Whether the ray o + t d with t in [0, tmax] meets the box [lo, hi] (slab test, Kay and Kajiya
+/// 1986), given `inv_d` = [`safe_inverse`]`(d)` and `o_inv_d` = o · inv_d precomputed per ray.
+/// Twin of GLSL `intersect_aabb`.
 pub fn intersect_aabb(o_inv_d: Vec3, inv_d: Vec3, lo: Vec3, hi: Vec3, tmax: f32) -> bool {
     let t0 = lo * inv_d - o_inv_d;
     let t1 = hi * inv_d - o_inv_d;
@@ -228,6 +242,8 @@ pub fn intersect_aabb(o_inv_d: Vec3, inv_d: Vec3, lo: Vec3, hi: Vec3, tmax: f32)
     enter <= leave
 }
 
+/// Componentwise 1/d, with 1e30 for a zero component so that the slab test stays finite.
+/// Twin of GLSL `safe_inverse`.
 pub fn safe_inverse(d: Vec3) -> Vec3 {
     let inv = |x: f32| if x != 0.0 { 1.0 / x } else { 1e30 };
     Vec3::new(inv(d.x), inv(d.y), inv(d.z))
@@ -308,8 +324,11 @@ pub fn segment_occluded(nodes: &[BvhNode], triangles: &[Triangle], p: Vec3, np: 
 /// A ray of `trace_pair`; `tmax <= 0` makes it inactive (no hit, no node visit of its own).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairRay {
+    /// Ray origin in scene coordinates (already offset off its surface).
     pub origin: Vec3,
+    /// Ray direction in scene coordinates; hits count for t in (0, tmax) in units of |dir|.
     pub dir: Vec3,
+    /// The farthest ray parameter that counts.
     pub tmax: f32,
 }
 

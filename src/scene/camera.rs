@@ -18,11 +18,14 @@ pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 pub struct Camera {
     /// The glTF node's or camera's name.
     pub name: String,
-    /// Position in scene coordinates and an orthonormal frame: `forward` is the viewing
-    /// direction, `up` and `right` span the image plane.
+    /// Position in scene coordinates; with `forward`, `up` and `right` (an orthonormal frame)
+    /// it places the image plane.
     pub position: Vec3,
+    /// Unit viewing direction (the glTF camera's -Z), scene coordinates.
     pub forward: Vec3,
+    /// Unit up axis of the image (towards its top row), scene coordinates.
     pub up: Vec3,
+    /// Unit right axis of the image, `forward × up`, scene coordinates.
     pub right: Vec3,
     /// Vertical field of view in radians.
     pub yfov: f32,

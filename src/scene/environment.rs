@@ -19,7 +19,9 @@ use crate::scene::luminance;
 /// An equirectangular map with its sampling tables.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvironmentMap {
+    /// Width in texels (longitude: u from 0 to 1 covers 2π).
     pub width: u32,
+    /// Height in texels (latitude: v from 0, +Y, to 1, -Y).
     pub height: u32,
     /// Radiance, row-major from the top row (+Y).
     pub texels: Vec<Vec3>,

@@ -13,7 +13,9 @@ use crate::gpu_types::Triangle;
 /// (`crate::vk::Context::scene_array_limit`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ArrayLimit {
+    /// The limit in bytes.
     pub bytes: u64,
+    /// The Vulkan limit's name, e.g. "maxStorageBufferRange".
     pub name: &'static str,
 }
 

@@ -8,14 +8,23 @@ mod textures;
 
 pub use textures::{textured_sphere, FILTER_LINEAR, FILTER_NEAREST, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT};
 
+/// A glTF metallic-roughness material to write (the fields map to [`crate::gpu_types::Material`]'s).
 #[derive(Debug, Clone, Copy)]
 pub struct MaterialSpec {
+    /// baseColorFactor (linear RGB; alpha is written as 1).
     pub base_color: Vec3,
+    /// metallicFactor in [0, 1].
     pub metallic: f32,
+    /// roughnessFactor (perceptual roughness) in [0, 1].
     pub roughness: f32,
+    /// Emitted radiance (linear RGB, W/(m² sr)); written as emissiveFactor scaled to at most 1
+    /// and `KHR_materials_emissive_strength` for the rest.
     pub emission: Vec3,
+    /// `KHR_materials_transmission` transmissionFactor in [0, 1]; written when non-zero.
     pub transmission: f32,
+    /// `KHR_materials_ior`; written (with the transmission) only when `transmission` > 0.
     pub ior: f32,
+    /// glTF `doubleSided`.
     pub double_sided: bool,
     /// `KHR_materials_specular` specularFactor of the non-metal part (glTF's default is 1);
     /// written only where it differs from 1 on a material with a non-metal part.
@@ -36,6 +45,7 @@ impl MaterialSpec {
             specular: 0.0,
         }
     }
+    /// A GGX conductor (metallic 1) of F0 `c` and perceptual `roughness`.
     pub fn conductor(c: Vec3, roughness: f32) -> Self {
         Self {
             metallic: 1.0,
@@ -43,6 +53,8 @@ impl MaterialSpec {
             ..Self::diffuse(c)
         }
     }
+    /// A clear dielectric (transmission 1, white) of index `ior`; roughness below about 0.032 is
+    /// a smooth interface.
     pub fn glass(ior: f32, roughness: f32) -> Self {
         Self {
             transmission: 1.0,
@@ -60,6 +72,7 @@ impl MaterialSpec {
             ..Self::diffuse(c)
         }
     }
+    /// A black, one-sided area light emitting `radiance` (linear RGB, W/(m² sr)) from its front.
     pub fn emitter(radiance: Vec3) -> Self {
         Self {
             emission: radiance,
@@ -71,7 +84,9 @@ impl MaterialSpec {
 /// A triangle mesh in object space; triangles wound counter-clockwise seen from the front.
 #[derive(Debug, Clone, Default)]
 pub struct MeshData {
+    /// Vertex positions, object space.
     pub positions: Vec<Vec3>,
+    /// Three indices into `positions` per triangle.
     pub indices: Vec<u32>,
 }
 
@@ -133,6 +148,7 @@ impl MeshData {
         out
     }
 
+    /// One mesh holding both: `other`'s vertices appended, its indices shifted to match.
     pub fn merged(&self, other: &MeshData) -> MeshData {
         let base = self.positions.len() as u32;
         let mut out = self.clone();
@@ -142,6 +158,9 @@ impl MeshData {
     }
 }
 
+/// Assembles a glTF 2.0 document (one embedded buffer, materials, meshes, nodes, cameras, lights,
+/// textures) item by item; [`GltfBuilder::finish`] returns its JSON text. Indices returned by the
+/// adding methods are glTF array indices, for use in later calls.
 #[derive(Default)]
 pub struct GltfBuilder {
     buffer: Vec<u8>,
@@ -179,6 +198,7 @@ impl GltfBuilder {
         }
     }
 
+    /// Adds material `m` named `name`, declaring the extensions it needs; returns its index.
     pub fn material(&mut self, name: &str, m: MaterialSpec) -> usize {
         let mut value = json!({
             "name": name,
@@ -234,6 +254,8 @@ impl GltfBuilder {
         self.buffer_views.len() - 1
     }
 
+    /// Adds a triangle-list mesh of `data` drawn with material index `material`; returns the mesh
+    /// index (place it with [`GltfBuilder::instance`]).
     pub fn mesh(&mut self, name: &str, data: &MeshData, material: usize) -> usize {
         self.mesh_primitive(name, &data.positions, &data.indices, MODE_TRIANGLES, None, material)
     }

@@ -45,14 +45,15 @@ pub struct Scene {
     /// Triangles in BVH leaf order, each with its material and emitter index.
     pub triangles: Vec<Triangle>,
     /// Vertex attributes of `triangles` (same order), or empty: a scene of flat faces without
-    /// textures has none (see src/surface.rs).
+    /// textures has none (see src/shading/surface.rs).
     pub surfaces: Vec<TriangleSurface>,
     /// The materials' textures (empty: none).
     pub textures: SceneTextures,
     /// The BVH over `triangles`, in depth-first order with skip links (src/scene/bvh.rs).
     pub nodes: Vec<BvhNode>,
-    /// Materials by index (`Triangle::material`), and their names from the file.
+    /// Materials by index (`Triangle::material`).
     pub materials: Vec<Material>,
+    /// The materials' names from the file, parallel to `materials` (for messages and reports).
     pub material_names: Vec<String>,
     /// Light-sampling table: emissive triangles then punctual lights, each with its alias-table
     /// entry and selection pdf.
@@ -88,17 +89,27 @@ pub struct Scene {
 /// Input to [`Scene::build`]: triangles as loaded, each tagged with its material.
 /// Fields mean what the [`Scene`] fields of the same names mean; `triangles` in any order.
 pub struct SceneParts {
+    /// See [`Scene::source`].
     pub source: PathBuf,
+    /// The triangles in scene coordinates, in any order.
     pub triangles: Vec<Triangle>,
     /// Vertex attributes parallel to `triangles`, or empty.
     pub surfaces: Vec<TriangleSurface>,
+    /// See [`Scene::textures`].
     pub textures: SceneTextures,
+    /// See [`Scene::materials`].
     pub materials: Vec<Material>,
+    /// See [`Scene::material_names`].
     pub material_names: Vec<String>,
+    /// See [`Scene::environment`].
     pub environment: Vec3,
+    /// See [`Scene::environment_map`].
     pub environment_map: Option<EnvironmentMap>,
+    /// See [`Scene::cameras`].
     pub cameras: Vec<Camera>,
+    /// See [`Scene::lights`].
     pub lights: Vec<PunctualLight>,
+    /// See [`Scene::warnings`].
     pub warnings: Vec<String>,
 }
 

@@ -10,8 +10,12 @@ use super::luminance;
 /// The kind of a punctual light; the values are those of glsl/types.glsl.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PunctualKind {
+    /// Emits the same intensity in every direction from `position`.
     Point = 0,
+    /// A point light restricted to a cone around `direction`, with a smooth edge between the inner
+    /// and outer angles.
     Spot = 1,
+    /// Parallel light along `direction` from infinitely far away, e.g. the sun.
     Directional = 2,
 }
 
@@ -22,6 +26,7 @@ pub enum PunctualKind {
 /// "Units").
 #[derive(Debug, Clone, PartialEq)]
 pub struct PunctualLight {
+    /// Point, spot or directional.
     pub kind: PunctualKind,
     /// Position (point and spot) relative to `Scene::origin`, unused for directional lights.
     pub position: Vec3,
@@ -29,8 +34,10 @@ pub struct PunctualLight {
     pub direction: Vec3,
     /// colour × intensity: radiant intensity (point, spot) or irradiance (directional).
     pub intensity: Vec3,
-    /// Cosines of the spot cone's inner and outer angles (1 and -1 for other kinds).
+    /// Cosine of the spot cone's inner angle, inside which the light is at full intensity (1 for
+    /// other kinds).
     pub cos_inner: f32,
+    /// Cosine of the spot cone's outer angle, outside which it emits nothing (-1 for other kinds).
     pub cos_outer: f32,
 }
 

@@ -16,7 +16,9 @@ use crate::shading::texture::{material_alpha, SceneTextures, ALPHA_MASK, ALPHA_O
 /// compiled with `SCENE_ALPHA`.
 #[derive(Clone, Copy)]
 pub struct AlphaScene<'a> {
+    /// Per-triangle vertex attributes, indexed like the scene's triangles.
     pub surfaces: &'a [TriangleSurface],
+    /// The texture table: materials' alpha modes, cutoffs and base-colour textures.
     pub textures: &'a SceneTextures,
 }
 

@@ -23,8 +23,10 @@ pub struct AlphaPass {
     pub tested: Hit,
     /// Alpha-tested hits met before the then-nearest opaque hit (at least those before it).
     pub count: u32,
-    /// Hits at or before (`bound_t`, `bound_triangle`) in (t, index) order do not count.
+    /// Distance of the last rejected hit: hits at or before (`bound_t`, `bound_triangle`) in
+    /// (t, index) order do not count (0 before any rejection).
     pub bound_t: f32,
+    /// Triangle index of the last rejected hit (`NO_HIT` before any rejection).
     pub bound_triangle: u32,
 }
 

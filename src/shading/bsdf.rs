@@ -22,19 +22,33 @@ pub fn index_matched(eta: f32) -> bool {
     (eta - 1.0).abs() <= INDEX_MATCHED_TOLERANCE
 }
 
+/// Lobe bits of a sampled direction ([`BsdfSample::lobe`], `PathRecord::lobes`); shared with
+/// glsl/bsdf.glsl. No lobe: a failed sample, or a vertex whose successor NEE chose.
 pub const LOBE_NONE: u32 = 0;
+/// The Lambertian base of the non-metal part.
 pub const LOBE_DIFFUSE: u32 = 1;
 /// GGX reflection: the conductor and the non-metal specular layer.
 pub const LOBE_CONDUCTOR: u32 = 2;
+/// The dielectric interface (transmission part), reflected or refracted.
 pub const LOBE_DIELECTRIC: u32 = 4;
+/// Set with another bit when that lobe was a perfect (delta) specular: `pdf` is then a discrete
+/// probability, not a density, and the direction cannot be reached by another technique.
 pub const LOBE_DELTA: u32 = 8;
+/// Set with [`LOBE_DIELECTRIC`] when the direction crossed the surface (refraction).
 pub const LOBE_TRANSMISSION: u32 = 16;
 
+/// A direction sampled from the BSDF (twin of GLSL `BsdfSample`, glsl/bsdf.glsl). A failed
+/// sample has zero `weight`, zero `pdf` and [`LOBE_NONE`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSample {
+    /// The incident (light) direction, unit, world space, pointing away from the surface.
     pub wi: Vec3,
+    /// f · |cos θi| / pdf, linear RGB: the path throughput factor of this bounce.
     pub weight: Vec3,
+    /// Solid-angle density of `wi` summed over the non-delta lobes (1/sr), or for a delta lobe
+    /// the discrete probability of that choice.
     pub pdf: f32,
+    /// The `LOBE_*` bits of the lobe that produced `wi`.
     pub lobe: u32,
 }
 
@@ -47,10 +61,16 @@ impl BsdfSample {
     };
 }
 
+/// GGX alpha from perceptual roughness, alpha = roughness² (glTF metallic-roughness, Burley 2012).
+/// Twin of GLSL `ggx_alpha`.
 pub fn ggx_alpha(roughness: f32) -> f32 {
     roughness * roughness
 }
 
+/// The isotropic GGX (Trowbridge-Reitz) normal distribution D(h) for a unit half-vector `h` in the
+/// local frame (+z the normal), in 1/sr (pbrt-v4 `TrowbridgeReitzDistribution::D`). Twin of GLSL
+/// `ggx_d`.
+///
 /// sin^2 comes from x^2 + y^2 rather than 1 - z^2: near the lobe peak of a narrow GGX the
 /// latter cancels catastrophically in f32.
 pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
@@ -59,6 +79,9 @@ pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
     a2 / (PI * d * d)
 }
 
+/// Smith's auxiliary function Λ(w) for GGX (pbrt-v4 `TrowbridgeReitzDistribution::Lambda`),
+/// `w` unit in the local frame; 0 at normal incidence, and returned as 0 for w.z = 0. Twin of GLSL
+/// `smith_lambda`.
 pub fn smith_lambda(w: Vec3, alpha: f32) -> f32 {
     let c2 = w.z * w.z;
     if c2 <= 0.0 {
@@ -68,24 +91,35 @@ pub fn smith_lambda(w: Vec3, alpha: f32) -> f32 {
     0.5 * (-1.0 + (1.0 + alpha * alpha * t2).sqrt())
 }
 
+/// Smith's masking function G1(w) = 1 / (1 + Λ(w)), unitless in [0, 1]. Twin of GLSL `smith_g1`.
 pub fn smith_g1(w: Vec3, alpha: f32) -> f32 {
     1.0 / (1.0 + smith_lambda(w, alpha))
 }
 
+/// The height-correlated masking-shadowing G2 = 1 / (1 + Λ(wo) + Λ(wi)) (Heitz 2014; pbrt-v4
+/// `TrowbridgeReitzDistribution::G`). Twin of GLSL `smith_g2`.
 pub fn smith_g2(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
     1.0 / (1.0 + smith_lambda(wo, alpha) + smith_lambda(wi, alpha))
 }
 
+/// Density of half-vector `h` under visible-normal sampling from `wo` (Heitz 2018):
+/// G1(wo) max(0, wo·h) D(h) / |wo.z|, in 1/sr of h, local frame. Twin of GLSL `ggx_vndf_pdf`.
 pub fn ggx_vndf_pdf(wo: Vec3, h: Vec3, alpha: f32) -> f32 {
     smith_g1(wo, alpha) * wo.dot(h).max(0.0) * ggx_d(h, alpha) / wo.z.abs()
 }
 
+/// Schlick's Fresnel approximation F0 + (1 - F0)(1 - cos θ)⁵ per RGB channel; `cos_theta` is
+/// clamped to [0, 1]. Twin of GLSL `fresnel_schlick`.
 pub fn fresnel_schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
     let m = (1.0 - cos_theta).clamp(0.0, 1.0);
     let m5 = (m * m) * (m * m) * m;
     f0 + (Vec3::ONE - f0) * m5
 }
 
+/// Unpolarised Fresnel reflectance of a dielectric interface (pbrt-v4 `FrDielectric`): `cos_i`
+/// is the cosine to the normal on the outside (negative: the ray arrives from inside, and `eta`
+/// is inverted), `eta` = IOR inside / IOR outside. 1 under total internal reflection. Twin of
+/// GLSL `fresnel_dielectric`.
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let (eta, cos_i) = if cos_i < 0.0 { (1.0 / eta, -cos_i) } else { (eta, cos_i) };
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);

@@ -26,8 +26,11 @@ pub enum Mis {
 /// number of candidates it stands for).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Input<S> {
+    /// X_i, in input i's own domain.
     pub sample: S,
+    /// W_{X_i}: an unbiased estimate of 1 / p(X_i) (Lin et al. 2022).
     pub contribution_weight: f64,
+    /// c_i, the number of candidates X_i stands for (ReSTIR's M); weights the MIS.
     pub confidence: f64,
 }
 
@@ -141,17 +144,22 @@ pub fn target_function(contribution: Vec3) -> f32 {
 /// its functions in glsl/reservoir.glsl.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Resampler<S> {
+    /// The chosen candidate so far; `None` before the first is chosen.
     pub chosen: Option<S>,
+    /// p̂ of the chosen candidate.
     pub chosen_target: f32,
+    /// sum_j w_j over the candidates offered so far.
     pub weight_sum: f32,
     /// The confidence M of the result: the sum of the inputs' confidence weights, which the
     /// caller adds.
     pub confidence: f32,
+    /// sum_i w_i f(y_i) / p̂(y_i) over the candidates offered (linear RGB).
     pub expected: Vec3,
     /// The chosen candidate could not be recorded: the result is empty.
     pub chosen_lost: bool,
 }
 
+/// An empty resampler: nothing chosen, all sums 0. Twin of GLSL `resampler_begin`.
 pub fn resampler_begin<S>() -> Resampler<S> {
     Resampler {
         chosen: None,

@@ -9,11 +9,20 @@ use crate::gpu_types::{Emitter, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::{PunctualKind, PunctualLight, Scene};
 use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
+/// A next-event-estimation sample from a shading point (twin of GLSL `LightSample`,
+/// glsl/lights.glsl). A failed sample has zero `pdf` and `radiance`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightSample {
+    /// Unit direction from the shading point towards the light, world space.
     pub dir: Vec3,
+    /// Distance to the sampled point in scene units; infinite for the environment and
+    /// directional lights.
     pub dist: f32,
+    /// Radiance arriving along `dir` (linear RGB, W/(m² sr)); for a punctual light the
+    /// irradiance-like I·falloff/d² or E that multiplies f_s |cos|.
     pub radiance: Vec3,
+    /// Solid-angle density of `dir` (1/sr), selection probability included; for a punctual
+    /// light the discrete probability of choosing it.
     pub pdf: f32,
     /// The emitter triangle sampled, NO_EMITTER for the environment, PUNCTUAL_LIGHT_BIT | k for
     /// punctual light k.
@@ -124,6 +133,10 @@ pub fn emitted_radiance(scene: &Scene, triangle: u32, bary: glam::Vec2, to_viewe
     }
 }
 
+/// The emitter index the alias table `emitters[..count]` gives for uniform `u` in [0, 1): slot
+/// floor(u · count), kept if the remaining fraction is below its `alias_prob`, else its `alias`
+/// (one uniform does both, Vose's method as in pbrt-v4 `AliasTable::Sample`). Twin of GLSL
+/// `alias_select`.
 pub fn alias_select(emitters: &[Emitter], u: f32, count: u32) -> u32 {
     let scaled = u * count as f32;
     let i = (scaled as u32).min(count - 1);
@@ -135,6 +148,10 @@ pub fn alias_select(emitters: &[Emitter], u: f32, count: u32) -> u32 {
     }
 }
 
+/// Solid-angle density (1/sr) with which [`sample_light`] picks the point at distance `dist`
+/// along unit `dir` on emissive triangle `tri_index`: (1 - env_select_prob) · select_pdf / area
+/// · dist² / |cos θ_light|. 0 for a triangle that does not emit or is seen edge-on. Twin of GLSL
+/// `emitter_pdf`.
 pub fn emitter_pdf(scene: &Scene, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
     let tri = &scene.triangles[tri_index as usize];
     if tri.emitter == NO_EMITTER {

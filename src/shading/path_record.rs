@@ -16,9 +16,15 @@ const INFO_LENGTH_MASK: u32 = 0xf;
 const INFO_RC_SHIFT: u32 = 4;
 const INFO_NEE_END: u32 = 1 << 8;
 
+/// A reservoir's path sample (glsl/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
+/// GPU split into [`crate::gpu_types::ReservoirHead`] and [`crate::gpu_types::ReservoirTail`]).
+/// x_0 is the camera, x_1..x_k the path's vertices, x_r the reconnection vertex; positions and
+/// directions are in scene coordinates, colours linear RGB.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct PathRecord {
+    /// The path's random-number key ([`crate::shading::rng::path_seed`]): random replay
+    /// regenerates the path from it.
     pub seed: u32,
     /// Bits 0-3: the length k; bits 4-7: the reconnection index r (0: none); bit 8: NEE end.
     pub info: u32,
@@ -46,14 +52,18 @@ pub struct PathRecord {
 }
 
 impl PathRecord {
+    /// The `info` word for a path of `length` vertices, reconnection index r (`None`: no
+    /// reconnection vertex) and end type. Twin of GLSL `pack_info`.
     pub fn pack_info(length: usize, reconnection: Option<usize>, nee_end: bool) -> u32 {
         length as u32 | (reconnection.unwrap_or(0) as u32) << INFO_RC_SHIFT | if nee_end { INFO_NEE_END } else { 0 }
     }
 
+    /// The `lobes` word: `lobes[i]` (a `LOBE_*` value below 2⁵) in bits 5i..5i+4, for x1 onwards.
     pub fn pack_lobes(lobes: &[u32]) -> u32 {
         lobes.iter().enumerate().fold(0, |acc, (i, &l)| acc | l << (LOBE_BITS * i as u32))
     }
 
+    /// f(X), linear RGB.
     pub fn contribution(&self) -> Vec3 {
         Vec3::from(self.contribution)
     }

@@ -2,8 +2,13 @@
 
 use glam::{UVec4, Vec4};
 
+/// Stream of [`rng_uniform4`]: the camera ray's jitter within the pixel (vertex 0).
 pub const STREAM_CAMERA: u32 = 0;
+/// Stream of [`rng_uniform4`]: BSDF sampling at a vertex (xy: direction, z: lobe choice, w:
+/// reflect/refract choice).
 pub const STREAM_BSDF: u32 = 1;
+/// Stream of [`rng_uniform4`]: next-event estimation at a vertex (the light choice and the point
+/// or direction on it).
 pub const STREAM_LIGHT: u32 = 2;
 /// ReSTIR's choices among candidates, keyed by a pass seed.
 pub const STREAM_RESAMPLE: u32 = 3;
@@ -23,14 +28,22 @@ pub fn pcg4d(v: UVec4) -> UVec4 {
     v
 }
 
+/// The key of one path: a hash of the pixel index (row-major), the pixel's sample index and the
+/// render's seed. Everything random along the path derives from it, so random replay only needs
+/// the key (Lin et al. 2022, random-number replay). Twin of GLSL `path_seed`.
 pub fn path_seed(pixel: u32, sample_index: u32, seed: u32) -> u32 {
     pcg4d(UVec4::new(pixel, sample_index, seed, 0x9e3779b9)).x
 }
 
+/// A uniform float in [0, 1) from the top 24 bits of `x` (exactly representable, never 1).
+/// Twin of GLSL `u32_to_unit_float`.
 pub fn u32_to_unit_float(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16777216.0)
 }
 
+/// Four uniforms in [0, 1) for path key `seed`, path vertex `vertex` (0: the camera) and one of the
+/// `STREAM_*` uses: counter-based, so any vertex's numbers can be drawn again in any order.
+/// Twin of GLSL `rng_uniform4`.
 pub fn rng_uniform4(seed: u32, vertex: u32, stream: u32) -> Vec4 {
     let h = pcg4d(UVec4::new(seed, vertex, stream, 0x68e31da4));
     Vec4::new(

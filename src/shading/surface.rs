@@ -47,7 +47,9 @@ pub struct SurfaceHit {
     pub tangent: Vec3,
     /// ±1: the bitangent is `handedness * normal.cross(tangent)`.
     pub handedness: f32,
+    /// Interpolated TEXCOORD_0 (glTF convention: v = 0 is the image's top row); zero if absent.
     pub uv0: Vec2,
+    /// Interpolated TEXCOORD_1; zero if absent.
     pub uv1: Vec2,
 }
 

@@ -10,21 +10,31 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::gpu_types::Material;
 use crate::shading::surface::SurfaceHit;
 
+/// [`TextureSlot::texture_index`] of a slot without a texture: the factor applies alone.
 pub const NO_TEXTURE: u32 = u32::MAX;
+/// Wrap mode (2 bits of [`TextureHeader::sampler_bits`]): glTF REPEAT, the coordinate's
+/// fractional part.
 pub const TEXTURE_WRAP_REPEAT: u32 = 0;
+/// Wrap mode: glTF CLAMP_TO_EDGE, coordinates clamped to the edge texels.
 pub const TEXTURE_WRAP_CLAMP: u32 = 1;
+/// Wrap mode: glTF MIRRORED_REPEAT, every other repetition mirrored.
 pub const TEXTURE_WRAP_MIRROR: u32 = 2;
 /// Sampler bit: nearest-texel (magnification) filtering instead of bilinear.
 pub const TEXTURE_NEAREST: u32 = 16;
+/// [`MaterialTextures::alpha_mode`]: glTF `OPAQUE`, alpha ignored.
 pub const ALPHA_OPAQUE: u32 = 0;
+/// glTF `MASK`: a hit whose alpha is below `alpha_cutoff` is no hit ([`crate::shading::alpha`]).
 pub const ALPHA_MASK: u32 = 1;
+/// glTF `BLEND`, rendered as stochastic transparency: a hit is kept with probability alpha.
 pub const ALPHA_BLEND: u32 = 2;
 
 /// A texture's place in [`SceneTextures::texels`] and its sampler (glsl/surface_bindings.glsl).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct TextureHeader {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
     /// Index of the first texel; rows run from the image's top row (v = 0) down.
     pub offset: u32,
@@ -38,9 +48,11 @@ pub struct TextureHeader {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct TextureSlot {
+    /// First row of the affine uv map (identity: (1, 0, 0)).
     pub u_row: [f32; 3],
     /// Index into the headers, or [`NO_TEXTURE`].
     pub texture_index: u32,
+    /// Second row of the affine uv map (identity: (0, 1, 0)).
     pub v_row: [f32; 3],
     /// TEXCOORD_0 or TEXCOORD_1.
     pub texcoord: u32,
@@ -69,7 +81,9 @@ pub struct MaterialTextures {
     pub emissive: TextureSlot,
     /// Tangent-space normal, (x, y) scaled by `normal_scale`.
     pub normal: TextureSlot,
+    /// glTF `normalTexture.scale`: multiplies the tangent-space normal's x and y (default 1).
     pub normal_scale: f32,
+    /// glTF `alphaCutoff` (default 0.5): the alpha below which an `ALPHA_MASK` hit is discarded.
     pub alpha_cutoff: f32,
     /// `ALPHA_OPAQUE`, `ALPHA_MASK` or `ALPHA_BLEND`.
     pub alpha_mode: u32,
@@ -80,6 +94,7 @@ pub struct MaterialTextures {
 /// The scene's textures; all empty when no material has one.
 #[derive(Debug, Clone, Default)]
 pub struct SceneTextures {
+    /// One per texture, indexed by [`TextureSlot::texture_index`].
     pub headers: Vec<TextureHeader>,
     /// RGBA8 texels, R in the low byte.
     pub texels: Vec<u32>,
@@ -88,6 +103,8 @@ pub struct SceneTextures {
 }
 
 impl SceneTextures {
+    /// Whether the scene has no material table: no material has a texture or a non-opaque alpha
+    /// mode.
     pub fn is_empty(&self) -> bool {
         self.materials.is_empty()
     }

@@ -9,6 +9,7 @@ use gpu_allocator::MemoryLocation;
 use super::Context;
 use crate::error::{allocation_error, vk_error, GpuError};
 
+/// What a buffer is for, which sets its Vulkan usage flags and its memory location.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BufferUsage {
     /// Read or written by kernels; lives in device memory, reached by staging copies. Also
@@ -52,14 +53,24 @@ impl BufferUsage {
     }
 }
 
+/// A Vulkan buffer with its gpu-allocator memory; both are freed on drop. It holds its
+/// [`Context`], which therefore outlives it.
 pub struct Buffer {
+    /// The raw buffer handle, for descriptor writes and commands recorded by hand.
     pub handle: vk::Buffer,
+    /// Size in bytes (at least 16).
     pub size: u64,
     allocation: Option<Allocation>,
     ctx: Arc<Context>,
 }
 
 impl Buffer {
+    /// Creates an uninitialised buffer of `size` bytes (at least 16: Vulkan has no empty
+    /// buffers) for `usage`; `name` labels the allocation and errors. Errors:
+    /// [`GpuError::BindingTooLarge`] for a `Storage` buffer past maxStorageBufferRange,
+    /// [`GpuError::AllocationTooLarge`] for an `Addressed` one past maxMemoryAllocationSize,
+    /// [`GpuError::OutOfMemory`], [`GpuError::Allocation`] or [`GpuError::Vulkan`] when
+    /// creating, allocating or binding fails.
     pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: BufferUsage) -> Result<Self, GpuError> {
         // Zero-sized buffers are illegal in Vulkan; empty arrays still get a valid binding.
         let size = size.max(16);

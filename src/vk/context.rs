@@ -24,9 +24,8 @@ pub struct ContextOptions {
     pub device: Option<String>,
     /// Enables VK_LAYER_KHRONOS_validation and counts every message it reports.
     pub validation: bool,
-    /// Bytes past which a scene array is reached by buffer device address rather than bound
-    /// (at most maxStorageBufferRange, the default). Tests lower it so that small scenes take
-    /// the addressed path.
+    /// Bytes past which a scene array is reached by buffer device address rather than bound (at most
+    /// maxStorageBufferRange, the default). Tests lower it so that small scenes take the addressed path.
     pub scene_binding_limit: Option<u64>,
 }
 
@@ -35,9 +34,11 @@ pub struct ContextOptions {
 pub struct DeviceInfo {
     /// The driver's device name (e.g. "llvmpipe (LLVM 15.0.7, 256 bits)").
     pub name: String,
+    /// CPU (lavapipe), integrated or discrete: CPU devices get uniform-buffer scene bindings.
     pub device_type: vk::PhysicalDeviceType,
-    /// maxStorageBufferRange and maxUniformBufferRange, in bytes.
+    /// maxStorageBufferRange: the most bytes one storage-buffer binding may cover.
     pub max_storage_buffer_range: u64,
+    /// maxUniformBufferRange: the most bytes one uniform-buffer binding may cover.
     pub max_uniform_buffer_range: u64,
     /// Bytes one scene array may take in a binding (maxStorageBufferRange, or less where
     /// `ContextOptions::scene_binding_limit` says so); larger ones are addressed.
@@ -49,9 +50,9 @@ pub struct DeviceInfo {
     pub max_allocation_bytes: u64,
     /// Bytes of shared memory a compute workgroup may use (Vulkan's floor: 16384).
     pub max_compute_shared_memory: u32,
-    /// Nanoseconds per timestamp tick (timestampPeriod), and whether the compute queue writes
-    /// timestamps at all (GPU times are reported as 0 where it does not).
+    /// Nanoseconds per timestamp tick (timestampPeriod).
     pub timestamp_period_ns: f32,
+    /// Whether the compute queue writes timestamps (timestampValidBits > 0, timestampComputeAndGraphics).
     pub timestamps_supported: bool,
     /// Iterations each loop of one shader invocation may run in total before the driver silently
     /// leaves it (llvmpipe: 65535); `None` where no such cap is known.
@@ -94,16 +95,18 @@ unsafe extern "system" fn debug_callback(
     vk::FALSE
 }
 
-/// One Vulkan device with its compute queue, memory allocator and (optionally) validation
-/// messenger: what every buffer, kernel and renderer is made on, shared as `Arc<Context>`
-/// (each of them holds a clone).
+/// One Vulkan device with its compute queue, memory allocator and (optionally) validation messenger:
+/// what every buffer, kernel and renderer is made on, shared as `Arc<Context>` (each holds a clone).
 pub struct Context {
     allocator: ManuallyDrop<Mutex<Allocator>>,
     command_pool: vk::CommandPool,
-    /// The raw handles, for code that records its own Vulkan work.
+    /// The compute queue all submissions use; raw handles, for code recording its own work.
     pub queue: vk::Queue,
+    /// The compute queue's family index.
     pub queue_family: u32,
+    /// The logical device (ash's loaded function table).
     pub device: ash::Device,
+    /// The physical device chosen.
     pub physical_device: vk::PhysicalDevice,
     /// The device's name and limits.
     pub info: DeviceInfo,
@@ -138,9 +141,8 @@ impl Context {
     /// virtual then CPU device) and creates the queue, allocator and messenger.
     ///
     /// # Errors
-    /// One line: no Vulkan loader, validation asked for without the layer installed, no device,
-    /// no device matching `options.device` (the available ones listed), or a failed Vulkan
-    /// call ([`GpuError`]).
+    /// One line: no Vulkan loader, validation asked for without the layer installed, no device, no
+    /// device matching `options.device` (the available ones listed), or a failed Vulkan call ([`GpuError`]).
     pub fn new(options: &ContextOptions) -> Result<Self> {
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| anyhow!("cannot load the Vulkan loader (libvulkan.so.1): {e}; run tools/setup.sh"))?;

@@ -11,9 +11,12 @@ use super::reflect::check_bindings;
 use super::{compile_kernel, Buffer, Context};
 use crate::error::{vk_error, GpuError};
 
+/// The descriptor kind of a buffer binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Binding {
+    /// A uniform buffer (std140 in GLSL, at most maxUniformBufferRange bytes).
     Uniform,
+    /// A storage buffer (std430 in GLSL, at most maxStorageBufferRange bytes).
     Storage,
 }
 
@@ -21,9 +24,13 @@ pub enum Binding {
 /// its descriptor kind. src/shader_interface.rs declares those of the renderers' kernels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BindingSlot {
+    /// Descriptor set number.
     pub set: u32,
+    /// Binding number within the set.
     pub binding: u32,
+    /// The GLSL block's type name declared at this binding (checked against the SPIR-V).
     pub block: &'static str,
+    /// Uniform or storage buffer.
     pub kind: Binding,
 }
 
@@ -47,7 +54,9 @@ impl BindingSlot {
 /// A buffer for the binding `slot` (checked against the kernel's layout by `Kernel::bind`).
 #[derive(Clone, Copy)]
 pub struct BoundBuffer<'a> {
+    /// The binding it goes to.
     pub slot: BindingSlot,
+    /// The buffer bound there, whole.
     pub buffer: &'a Buffer,
 }
 
@@ -77,12 +86,16 @@ pub struct KernelCompile {
 }
 
 impl KernelCompile {
+    /// The sum of the three stages, in milliseconds.
     pub fn total_ms(&self) -> f64 {
         self.glsl_ms + self.pipeline_ms + self.first_dispatch_ms
     }
 }
 
+/// A compute pipeline built from one GLSL file with its descriptor sets and their buffers. It
+/// holds its [`Context`]; pipeline, layouts and pool are destroyed on drop.
 pub struct Kernel {
+    /// The GLSL file name under glsl/, e.g. "pathtrace.comp" (named in errors and reports).
     pub name: String,
     compile: KernelCompile,
     /// The bindings of every set.

@@ -22,10 +22,13 @@ const STORAGE_CLASS_STORAGE_BUFFER: u32 = 12;
 /// One buffer binding of a SPIR-V module.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReflectedBinding {
+    /// Descriptor set number (0 when the module gives none).
     pub set: u32,
+    /// Binding number within the set.
     pub binding: u32,
     /// The block's type name (the GLSL block name), empty without debug names.
     pub block: String,
+    /// Uniform or storage buffer (a `BufferBlock`-decorated uniform counts as storage).
     pub kind: Binding,
 }
 

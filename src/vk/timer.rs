@@ -7,6 +7,8 @@ use ash::vk;
 use super::Context;
 use crate::error::{vk_error, GpuError};
 
+/// A timestamp query pool of `slots` begin/end pairs, one pair per pass; read back as
+/// milliseconds of GPU time per slot.
 pub struct PassTimer {
     pool: vk::QueryPool,
     slots: u32,
@@ -14,6 +16,8 @@ pub struct PassTimer {
 }
 
 impl PassTimer {
+    /// A pool for `slots` passes. Errors: [`GpuError::Vulkan`] or [`GpuError::OutOfMemory`] if the
+    /// query pool cannot be created.
     pub fn new(ctx: &Arc<Context>, slots: u32) -> Result<Self, GpuError> {
         let info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::TIMESTAMP)
@@ -31,10 +35,12 @@ impl PassTimer {
         unsafe { self.ctx.device.cmd_reset_query_pool(cmd, self.pool, 0, 2 * self.slots) };
     }
 
+    /// Records the begin timestamp of `slot` (top of pipe). Panics if `slot` >= the slot count.
     pub fn record_begin(&self, cmd: vk::CommandBuffer, slot: u32) {
         self.record(cmd, 2 * slot, vk::PipelineStageFlags::TOP_OF_PIPE);
     }
 
+    /// Records the end timestamp of `slot` (bottom of pipe). Panics if `slot` >= the slot count.
     pub fn record_end(&self, cmd: vk::CommandBuffer, slot: u32) {
         self.record(cmd, 2 * slot + 1, vk::PipelineStageFlags::BOTTOM_OF_PIPE);
     }

@@ -5,12 +5,15 @@ use serde_json::{json, Value};
 
 use super::{GltfBuilder, MeshData};
 
-/// glTF sampler wrap modes (OpenGL enums).
+/// glTF sampler wrap mode REPEAT (the OpenGL enum glTF uses).
 pub const WRAP_REPEAT: u32 = 10497;
+/// glTF sampler wrap mode CLAMP_TO_EDGE.
 pub const WRAP_CLAMP_TO_EDGE: u32 = 33071;
+/// glTF sampler wrap mode MIRRORED_REPEAT.
 pub const WRAP_MIRRORED_REPEAT: u32 = 33648;
-/// glTF sampler filters.
+/// glTF sampler filter NEAREST.
 pub const FILTER_NEAREST: u32 = 9728;
+/// glTF sampler filter LINEAR.
 pub const FILTER_LINEAR: u32 = 9729;
 
 impl GltfBuilder {

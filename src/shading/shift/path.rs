@@ -22,7 +22,9 @@ use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 /// what sampling it produced (lobes, pdfs, per-vertex weights).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Path {
+    /// The path's random-number key ([`crate::shading::rng::path_seed`]).
     pub seed: u32,
+    /// The camera position x0, scene coordinates.
     pub camera: Vec3,
     /// x1..xk.
     pub vertices: Vec<Vertex>,
@@ -39,6 +41,7 @@ pub struct Path {
 }
 
 impl Path {
+    /// k, the number of vertices after the camera.
     pub fn length(&self) -> usize {
         self.vertices.len()
     }
@@ -48,9 +51,14 @@ impl Path {
 /// carries no value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShiftResult {
+    /// Whether the shift produced a path; when false every other field is zero or empty.
     pub valid: bool,
+    /// The shifted path's record, as a reservoir would store it.
     pub record: PathRecord,
+    /// The shift's Jacobian determinant in primary sample space, |dU_Y / dU_X|
+    /// (docs/shift-mappings.md); finite and positive when valid.
     pub jacobian: f32,
+    /// f(T(x)) of the shifted path, linear RGB (the record's contribution).
     pub contribution: Vec3,
     /// The vertices the shift made: y1..y_{r-1} for a reconnection, the whole path for a replay.
     pub vertices: Vec<Vertex>,

@@ -219,15 +219,23 @@ pub(super) fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &PathRecor
 /// seen from each predecessor (1 for an escaped x_r) and the pdfs that chose x_r and x_{r+1}.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReconnectionTerms {
+    /// |cos_r| / |y_{r-1} - x_r|² on the offset path (1 for an escaped x_r).
     pub geometry_y: f32,
+    /// |cos_r| / |x_{r-1} - x_r|² on the base path (1 for an escaped x_r).
     pub geometry_x: f32,
+    /// Solid-angle pdf with which the offset path's y_{r-1} would choose x_r.
     pub pdf_y: f32,
+    /// Solid-angle pdf with which the base path's x_{r-1} chose x_r.
     pub pdf_x: f32,
+    /// p(x_r -> x_{r+1} | y_{r-1}) on the offset path; 1 when x_r ends the path or NEE chose x_{r+1}.
     pub pdf_after_y: f32,
+    /// p(x_r -> x_{r+1} | x_{r-1}) on the base path; 1 in the same cases.
     pub pdf_after_x: f32,
 }
 
 impl ReconnectionTerms {
+    /// The reconnection shift's Jacobian in primary sample space,
+    /// (p_y G_y) / (p_x G_x) · (p_after_y / p_after_x), unitless (Lin et al. 2022, reconnection shift).
     pub fn jacobian(&self) -> f32 {
         (self.pdf_y * self.geometry_y) / (self.pdf_x * self.geometry_x) * (self.pdf_after_y / self.pdf_after_x)
     }

@@ -22,13 +22,21 @@ pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
 /// The distance threshold as a fraction of the scene's smallest bounding-box extent.
 pub const DEFAULT_DISTANCE_FRACTION: f32 = 0.03;
 
+/// The reconnection criteria of the shifts (Lin et al. 2022: a vertex is reconnectable when it
+/// and its predecessor are rough and far enough apart). Twin of GLSL `ShiftParams`
+/// (glsl/shift_vertex.glsl); the kernels read it from [`crate::gpu_types::ReuseParams`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShiftParams {
+    /// Perceptual roughness below which a GGX lobe counts as glossy: such a vertex cannot be a
+    /// reconnection vertex.
     pub roughness_threshold: f32,
+    /// Minimum distance in scene units between a reconnection vertex and its predecessor.
     pub distance_threshold: f32,
 }
 
 impl ShiftParams {
+    /// The defaults for `scene`: [`DEFAULT_ROUGHNESS_THRESHOLD`] and [`DEFAULT_DISTANCE_FRACTION`]
+    /// of the smallest extent of its bounding box.
     pub fn for_scene(scene: &Scene) -> ShiftParams {
         let extent = (scene.bounds.1 - scene.bounds.0).max(Vec3::splat(1e-6));
         ShiftParams {
@@ -41,10 +49,14 @@ impl ShiftParams {
 /// A path vertex: a surface point, or (triangle == NO_HIT) a direction to the environment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Vertex {
+    /// The point in scene coordinates (a punctual light's position); for an escaped vertex or one on a
+    /// directional light, the unit direction towards the environment or the light.
     pub pos: Vec3,
     /// The geometric normal (unit, as wound; zero off surfaces); `vertex_shading` gives the
     /// shading normal.
     pub normal: Vec3,
+    /// The triangle hit, [`NO_HIT`] for an escaped vertex, or [`PUNCTUAL_LIGHT_BIT`] | k on punctual
+    /// light k.
     pub triangle: u32,
 }
 
