@@ -315,16 +315,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     } else {
         args.path.camera
     };
-    let record = check_reference(&args.reference, &path, last_camera)?;
-    if let Some(r) = record.as_ref().filter(|r| (r.width, r.height) != (width, height)) {
-        bail!(
-            "{}: {width}x{height} pixels, but its record says {}x{}: the image and its .json record do not belong together",
-            args.reference.display(),
-            r.width,
-            r.height
-        );
-    }
-    let reference_spp = record.map(|r| r.spp);
+    let reference_spp = check_reference(&args.reference, &path, last_camera, (width, height))?.map(|r| r.spp);
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     Ok(Setup {
         path,

@@ -46,9 +46,9 @@ pub fn read_record(reference: &Path) -> Result<Option<ReferenceRecord>> {
     Ok(Some(record))
 }
 
-/// Fails unless `reference` shows `scene` from `camera`; warns when it carries no record.
-/// Returns the record, if any.
-pub fn check_reference(reference: &Path, scene: &Path, camera: usize) -> Result<Option<ReferenceRecord>> {
+/// Fails unless `reference` shows `scene` from `camera` and its record agrees with the image's
+/// `size` (width, height); warns when it carries no record. Returns the record, if any.
+pub fn check_reference(reference: &Path, scene: &Path, camera: usize, size: (u32, u32)) -> Result<Option<ReferenceRecord>> {
     let Some(record) = read_record(reference)? else {
         eprintln!(
             "warning: {}: no {} record says which camera it shows; make sure it is camera {camera} of {}",
@@ -66,6 +66,16 @@ pub fn check_reference(reference: &Path, scene: &Path, camera: usize) -> Result<
             record.scene,
             scene_name(scene),
             scene.display()
+        );
+    }
+    if (record.width, record.height) != size {
+        bail!(
+            "{}: {}x{} pixels, but its record says {}x{}: the image and its .json record do not belong together",
+            reference.display(),
+            size.0,
+            size.1,
+            record.width,
+            record.height
         );
     }
     Ok(Some(record))
@@ -88,13 +98,14 @@ mod tests {
             height: 8,
             spp: 32,
         };
-        check_reference(&reference, scene, 5).unwrap();
+        check_reference(&reference, scene, 5, (16, 8)).unwrap();
         write_record(&reference, &record).unwrap();
         assert_eq!(read_record(&reference).unwrap(), Some(record));
-        check_reference(&reference, scene, 2).unwrap();
-        let err = check_reference(&reference, scene, 3).unwrap_err().to_string();
+        check_reference(&reference, scene, 2, (16, 8)).unwrap();
+        assert!(check_reference(&reference, scene, 2, (8, 8)).is_err(), "another size");
+        let err = check_reference(&reference, scene, 3, (16, 8)).unwrap_err().to_string();
         assert!(err.contains("camera 2") && err.contains("camera 3"), "{err}");
-        assert!(check_reference(&reference, Path::new("scenes/veach-door.gltf"), 2).is_err());
+        assert!(check_reference(&reference, Path::new("scenes/veach-door.gltf"), 2, (16, 8)).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

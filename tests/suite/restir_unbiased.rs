@@ -402,11 +402,10 @@ fn check_alpha_masked_cornell(configurations: &'static [(ShiftKind, ReuseMis)]) 
 }
 
 // Every shift's vertices and visibility tests must see the same holes in the screen. The hybrid
-// shift reconnects and replays; the other shifts are in the second test. Both are ignored for
-// their time: 83 s and 234 s run alone on the 2-core machine, each with its own 4096-spp
-// reference of this alpha-tested scene.
+// shift reconnects and replays (83 s run alone on the 2-core machine, with its own 4096-spp
+// reference of this alpha-tested scene); the other shifts are in the second test, ignored for
+// its time (234 s).
 #[test]
-#[ignore = "minutes; run with --ignored (docs/restir.md)"]
 fn restir_unbiased_alpha_masked_cornell() {
     check_alpha_masked_cornell(&[(ShiftKind::Hybrid, ReuseMis::GeneralizedBalance)]);
 }
