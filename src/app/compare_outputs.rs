@@ -199,7 +199,7 @@ fn write_strip(
         pixels: reference,
     }];
     panels.extend(chosen.iter().map(|(label, _, image)| StripPanel {
-        label: format!("{label} ({:.3} relMSE, last run at {budget} ms)", rel_mse(&image.mean, reference)),
+        label: format!("{label} ({:.3} relMSE, last run at {budget:.0} ms)", rel_mse(&image.mean, reference)),
         pixels: &image.mean,
     }));
     write_image_strip(path, width, height, &panels, inset)
