@@ -6,6 +6,7 @@
 
 use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
+use restir_pt::metrics::{mean, standard_error};
 use restir_pt::shading::bsdf::{bsdf_sample, index_matched, DELTA_ALPHA, LOBE_TRANSMISSION};
 
 use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
@@ -78,10 +79,9 @@ fn cases() -> Vec<Case> {
 /// Mean, standard error and largest energy of `energies`; panics on a non-finite one.
 fn stats(what: &str, energies: &[f32]) -> (f64, f64, f32) {
     assert!(energies.iter().all(|e| e.is_finite()), "{what}: non-finite sample weight");
-    let n = energies.len() as f64;
-    let mean = energies.iter().map(|&e| e as f64).sum::<f64>() / n;
-    let var = energies.iter().map(|&e| (e as f64 - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt(), energies.iter().fold(0.0f32, |a, &e| a.max(e)))
+    let values: Vec<f64> = energies.iter().map(|&e| e as f64).collect();
+    let se = standard_error(&values).expect("more than one sample");
+    (mean(values.iter().copied()), se, energies.iter().fold(0.0f32, |a, &e| a.max(e)))
 }
 
 fn check(what: &str, case: &Case, energies: &[f32]) -> f64 {

@@ -11,6 +11,7 @@
 
 use std::sync::atomic::AtomicBool;
 
+use restir_pt::metrics::{mean, standard_error};
 use restir_pt::render::{History, Image, PathTracer, RenderSettings, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind};
 use restir_pt::scene::Scene;
 
@@ -109,10 +110,8 @@ impl RenderSet {
 
     /// The mean energy ratio and its standard error between renders.
     fn energy(&self) -> (f64, f64) {
-        let n = self.energies.len() as f64;
-        let mean = self.energies.iter().sum::<f64>() / n;
-        let var = self.energies.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        (mean, (var / n).sqrt())
+        let se = standard_error(&self.energies).expect("more than one render");
+        (mean(self.energies.iter().copied()), se)
     }
 
     /// Welch's t of every block that fails the two-sided test at ALPHA.

@@ -4,6 +4,7 @@
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
+use restir_pt::metrics::{mean, standard_error};
 use restir_pt::scene::bvh::intersect_triangle;
 use restir_pt::shading::bsdf::{ggx_vndf_pdf, smith_g1};
 use restir_pt::shading::lights::{alias_select, sample_light};
@@ -254,7 +255,6 @@ fn environment_map_sampling_chi_square_and_pdf() {
     assert_fits("environment map texels", &obs, &exp);
     let n = 400_000;
     let values: Vec<f64> = (0..n).map(|_| map.pdf(r.unit_vector()) as f64 * 4.0 * PI).collect();
-    let mean = values.iter().sum::<f64>() / n as f64;
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n as f64 - 1.0) / n as f64;
-    assert!((mean - 1.0).abs() < 4.0 * var.sqrt(), "pdf integrates to {mean} +- {}", var.sqrt());
+    let (mean, se) = (mean(values.iter().copied()), standard_error(&values).unwrap());
+    assert!((mean - 1.0).abs() < 4.0 * se, "pdf integrates to {mean} +- {se}");
 }
