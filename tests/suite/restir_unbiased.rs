@@ -67,12 +67,12 @@ fn reference(scene: &std::sync::Arc<SceneGpu>) -> Image {
     pt.image().unwrap()
 }
 
-/// One independent ReSTIR chain of FRAMES frames with `seed`, along cameras 0..FRAMES or, with
-/// `static_camera`, from the last of them throughout; the last frame's image.
-fn render_chain(renderer: &mut Restir, seed: u32, static_camera: bool) -> (Image, f64) {
+/// One independent ReSTIR chain of `frames` frames with `seed`, along cameras 0..frames or,
+/// with `static_camera`, from camera FRAMES - 1 throughout; the last frame's image.
+fn render_chain(renderer: &mut Restir, seed: u32, frames: usize, static_camera: bool) -> (Image, f64) {
     renderer.reset(seed).unwrap();
     let mut failed = 0.0;
-    for frame in 0..FRAMES {
+    for frame in 0..frames {
         let camera = if static_camera { FRAMES - 1 } else { frame };
         let stats = renderer.frame(camera, false).unwrap();
         assert_eq!(stats.counters.nonfinite_pixels, 0, "non-finite pixels");
@@ -136,29 +136,32 @@ impl RenderSet {
 }
 
 /// How one scene's unbiasedness is judged.
-struct Unbiasedness {
-    scene: &'static str,
-    renders: u32,
+pub struct Unbiasedness {
+    pub scene: &'static str,
+    pub renders: u32,
     /// Initial paths per reservoir and frame.
-    candidates: u32,
+    pub candidates: u32,
     /// Reservoirs per pixel.
-    reservoirs: u32,
+    pub reservoirs: u32,
     /// Whether the unbiased path tracer (`candidates` spp, as many renders) is put through the same block
     /// test, and a configuration may fail as many blocks as it does: on scenes whose light
     /// arrives through rare, large samples, block means of a few dozen renders are skewed
     /// (most fall below the true mean), and Welch's t-test then fails more blocks than its
     /// level says even for an exact renderer.
-    path_tracer_control: bool,
+    pub path_tracer_control: bool,
     /// Whether every frame is seen from the same camera, so that temporal reuse stays within
     /// one pixel's domain instead of shifting between frames.
-    static_camera: bool,
-    configurations: &'static [(ShiftKind, ReuseMis)],
+    pub static_camera: bool,
+    /// Frames per chain: FRAMES along the camera path; a static camera may run longer chains,
+    /// so that the history's confidence grows towards the M-cap.
+    pub frames: usize,
+    pub configurations: &'static [(ShiftKind, ReuseMis)],
     /// The settings not named above.
-    base: RestirSettings,
+    pub base: RestirSettings,
 }
 
 /// Every shift with both resampling MIS weights.
-const EVERY_CONFIGURATION: &[(ShiftKind, ReuseMis)] = &[
+pub const EVERY_CONFIGURATION: &[(ShiftKind, ReuseMis)] = &[
     (ShiftKind::Reconnection, ReuseMis::GeneralizedBalance),
     (ShiftKind::Reconnection, ReuseMis::Pairwise),
     (ShiftKind::Replay, ReuseMis::GeneralizedBalance),
@@ -173,7 +176,15 @@ fn check_unbiased(test: Unbiasedness) {
 }
 
 /// `check_unbiased` on a scene built by the test (`test.scene` names it).
-fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
+pub fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
+    let name = test.scene;
+    let failures = unbiasedness_failures(test, scene);
+    assert!(failures.is_empty(), "{name}: biased against the path tracer: {failures:?}");
+}
+
+/// Renders `test` on `scene` and prints each configuration's energy ratio and block test; the
+/// configurations that fail, each with its energy and passing blocks.
+pub fn unbiasedness_failures(test: Unbiasedness, scene: &Scene) -> Vec<String> {
     let name = if test.static_camera {
         format!("{} (static camera)", test.scene)
     } else {
@@ -219,7 +230,7 @@ fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
         let mut set = RenderSet::new(reference.len());
         let mut failed_rate = 0.0;
         for seed in 0..test.renders {
-            let (image, failed) = render_chain(&mut renderer, 1000 + seed, test.static_camera);
+            let (image, failed) = render_chain(&mut renderer, 1000 + seed, test.frames, test.static_camera);
             failed_rate += failed / test.renders as f64;
             set.add(&image, &reference);
         }
@@ -242,7 +253,7 @@ fn check_unbiased_on(test: Unbiasedness, scene: &Scene) {
         }
     }
     assert_clean(&ctx);
-    assert!(failures.is_empty(), "{name}: biased against the path tracer: {failures:?}");
+    failures
 }
 
 // The default settings (one spatial neighbour) in motion, with every shift and MIS. 64 chains:
@@ -259,6 +270,7 @@ fn restir_unbiased_cornell() {
         reservoirs: 1,
         path_tracer_control: false,
         static_camera: false,
+        frames: FRAMES,
         configurations: EVERY_CONFIGURATION,
         base: RestirSettings::default(),
     });
@@ -278,6 +290,7 @@ fn restir_unbiased_cornell_static_camera() {
         reservoirs: 2,
         path_tracer_control: false,
         static_camera: true,
+        frames: FRAMES,
         configurations: &[
             (ShiftKind::Reconnection, ReuseMis::GeneralizedBalance),
             (ShiftKind::Hybrid, ReuseMis::Pairwise),
@@ -302,6 +315,7 @@ fn restir_unbiased_cornell_temporal_history() {
         reservoirs: 1,
         path_tracer_control: false,
         static_camera: false,
+        frames: FRAMES,
         configurations: &[
             (ShiftKind::Hybrid, ReuseMis::GeneralizedBalance),
             (ShiftKind::Reconnection, ReuseMis::Pairwise),
@@ -329,6 +343,7 @@ fn restir_unbiased_normal_mapped_box() {
         reservoirs: 1,
         path_tracer_control: true,
         static_camera: false,
+        frames: FRAMES,
         configurations: EVERY_CONFIGURATION,
         base: RestirSettings::default(),
     });
@@ -349,6 +364,7 @@ fn restir_unbiased_cornell_glossy() {
         reservoirs: 1,
         path_tracer_control: true,
         static_camera: false,
+        frames: FRAMES,
         configurations: EVERY_CONFIGURATION,
         base: RestirSettings::default(),
     });
@@ -369,6 +385,7 @@ fn restir_unbiased_veach_door() {
         reservoirs: 1,
         path_tracer_control: true,
         static_camera: false,
+        frames: FRAMES,
         configurations: EVERY_CONFIGURATION,
         base: RestirSettings::default(),
     });
@@ -393,6 +410,7 @@ fn check_alpha_masked_cornell(configurations: &'static [(ShiftKind, ReuseMis)]) 
             reservoirs: 1,
             path_tracer_control: false,
             static_camera: false,
+            frames: FRAMES,
             configurations,
             base: RestirSettings::default(),
         },
