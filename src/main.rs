@@ -23,8 +23,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a glTF scene (default: scenes/cornell.gltf) to EXR and PNG with ReSTIR PT (default)
-    /// or the path tracer.
+    /// Render a glTF scene (default: the built-in scenes/cornell.gltf) to EXR and PNG with ReSTIR
+    /// PT (default: frames of a still camera averaged for 8 s of GPU time; --frames N for exact
+    /// frame counts) or the path tracer.
     Render(app::RenderArgs),
     /// Print a scene's triangles, emitters, lights, materials, bounds and cameras; with
     /// --kernels, the SPIR-V size and compile time of each kernel the scene would use.

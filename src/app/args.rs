@@ -156,7 +156,8 @@ impl RestirArgs {
 /// environment replacing its own.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SceneArgs {
-    /// glTF 2.0 scene (.gltf or .glb); defaults to the bundled Cornell box.
+    /// glTF 2.0 scene (.gltf or .glb); defaults to the Cornell box built into the binary
+    /// (scenes/cornell.gltf).
     pub scene: Option<PathBuf>,
     /// The glTF scene to use (index into the file's scenes; default: its default scene).
     #[arg(long = "scene")]
@@ -168,8 +169,9 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
-    /// The file to load: the one given, or the bundled Cornell box.
-    pub fn path(&self) -> PathBuf {
+    /// The file to load: the one given, or the built-in Cornell box (errors: it cannot be
+    /// written to a cache or temporary folder).
+    pub fn path(&self) -> anyhow::Result<PathBuf> {
         scene_path(self.scene.as_deref())
     }
 

@@ -122,7 +122,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     // CPU time before bench() (argument parsing, loader start-up) belongs to the process too.
     whole.cpu = 0.0;
     let mut lap = Stopwatch::start();
-    let path = args.scene.path();
+    let path = args.scene.path()?;
     let scene = load_with_options(&path, &args.scene.load_options(None))?;
     let settings = RenderSettings {
         width: args.size.width,

@@ -282,7 +282,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
     if let Some(b) = args.budgets_ms.iter().find(|b| !(**b > 0.0) || !b.is_finite()) {
         bail!("--budgets-ms {b}: a budget must be a positive number of milliseconds");
     }
-    let path = scene_path(Some(&args.scene));
+    let path = scene_path(Some(&args.scene))?;
     let scene = load_with_warnings(&path)?;
     let (width, height, reference) = read_exr(&args.reference)?;
     if let Some(i) = reference.iter().position(|p| !p.is_finite()) {

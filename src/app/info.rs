@@ -33,7 +33,7 @@ pub struct InfoArgs {
 /// scene's kernels (the path tracer's and ReSTIR PT's with the given settings) on the device
 /// and prints their costs.
 pub fn info(args: InfoArgs) -> Result<()> {
-    let path = args.scene.path();
+    let path = args.scene.path()?;
     let start = std::time::Instant::now();
     let scene = load_with_options(&path, &args.scene.load_options(None))?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -48,6 +48,8 @@ pub fn info(args: InfoArgs) -> Result<()> {
             ..Default::default()
         };
         let scene_gpu = SceneGpu::upload(&ctx, &scene)?;
+        // One kernel at a time, so that each stage's process CPU time is that stage's alone.
+        restir_pt::vk::set_compile_threads(0);
         let mut reports = vec![PathTracer::new(&scene_gpu, &settings)?.compile_report().clone()];
         reports.extend(Restir::new(&scene_gpu, &settings, &restir)?.compile_reports());
         drop(scene_gpu);
@@ -58,22 +60,28 @@ pub fn info(args: InfoArgs) -> Result<()> {
 }
 
 /// One line per kernel: SPIR-V bytes and milliseconds of GLSL compile, pipeline creation and
-/// first dispatch (where llvmpipe compiles).
+/// first dispatch (where llvmpipe compiles), wall-clock and CPU time; the kernels are built one
+/// at a time, so the CPU time of a stage is its own and other processes do not inflate it.
 fn print_kernels(label: &str, reports: &[KernelCompile]) {
-    println!("kernels ({label}; compile stages in ms: GLSL (0: from the SPIR-V cache), pipeline, first dispatch):");
+    println!("kernels ({label}; ms per stage: GLSL (0: from the SPIR-V cache), pipeline, first dispatch; wall-clock, then CPU):");
     for k in reports {
         println!(
-            "  {:<40} {:>8} B SPIR-V | {:>7.0} {:>7.0} {:>7.0} | total {:>7.0} ms",
+            "  {:<38} {:>7} B SPIR-V | wall {:>6.0} {:>6.0} {:>6.0} = {:>6.0} | CPU {:>6.0} {:>6.0} {:>6.0} = {:>6.0}",
             k.name,
             k.spirv_bytes,
             k.glsl_ms,
             k.pipeline_ms,
             k.first_dispatch_ms,
-            k.total_ms()
+            k.total_ms(),
+            k.glsl_cpu_ms,
+            k.pipeline_cpu_ms,
+            k.first_dispatch_cpu_ms,
+            k.total_cpu_ms()
         );
     }
     let total: f64 = reports.iter().map(|k| k.total_ms()).sum();
-    println!("  all kernels: {total:.0} ms");
+    let cpu: f64 = reports.iter().map(|k| k.total_cpu_ms()).sum();
+    println!("  all kernels, one at a time: {total:.0} ms wall-clock, {cpu:.0} ms CPU");
 }
 
 /// Triangles of each material, by material index: materials of equal parameters (two glTF

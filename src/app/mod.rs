@@ -14,6 +14,7 @@ mod profile;
 mod reference;
 mod reference_record;
 mod render;
+mod render_loop;
 mod render_output;
 mod shard;
 mod stability;
@@ -39,14 +40,62 @@ use restir_pt::vk::{Context, ContextOptions};
 
 use args::DeviceArgs;
 
+/// The bundled scene a command renders when it is given none.
 pub const DEFAULT_SCENE: &str = "scenes/cornell.gltf";
 
-/// The scene to load: the given path, or the bundled Cornell box.
-pub fn scene_path(scene: Option<&Path>) -> PathBuf {
+/// The text of `DEFAULT_SCENE` (its buffers are data URIs), built into the binary: `cargo
+/// install` copies the binary alone, and a command without a scene works from any folder.
+const DEFAULT_SCENE_GLTF: &str = include_str!("../../scenes/cornell.gltf");
+
+/// The scene to load: the given path, or the built-in Cornell box (`default_scene_file`).
+pub fn scene_path(scene: Option<&Path>) -> Result<PathBuf> {
     match scene {
-        Some(p) => p.to_path_buf(),
-        None => bundled_file(Path::new(DEFAULT_SCENE)),
+        Some(p) => Ok(p.to_path_buf()),
+        None => default_scene_file(),
     }
+}
+
+/// Writes the built-in Cornell box to `$XDG_CACHE_HOME/restir-pt/scenes/DIGEST/cornell.gltf`
+/// (`~/.cache` without XDG_CACHE_HOME, the temporary folder without either) unless it is
+/// there already, and returns that path; DIGEST names the content, so a file is never stale.
+/// The file keeps the name `cornell.gltf`, which names the outputs (out/cornell.exr).
+fn default_scene_file() -> Result<PathBuf> {
+    use sha2::{Digest, Sha256};
+    let digest: String = Sha256::digest(DEFAULT_SCENE_GLTF.as_bytes())[..8]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let cache = var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|h| h.join(".cache")));
+    let name = Path::new(DEFAULT_SCENE).file_name().unwrap_or_default();
+    let mut errors = Vec::new();
+    for base in cache.into_iter().chain([std::env::temp_dir()]) {
+        let dir = base.join("restir-pt").join("scenes").join(&digest);
+        let file = dir.join(name);
+        match write_once(&dir, &file) {
+            Ok(()) => {
+                eprintln!(
+                    "scene: the built-in Cornell box ({DEFAULT_SCENE}, written to {}); give a glTF file to render another",
+                    file.display()
+                );
+                return Ok(file);
+            }
+            Err(e) => errors.push(format!("{}: {e}", file.display())),
+        }
+    }
+    anyhow::bail!("cannot write the built-in scene: {}", errors.join("; "))
+}
+
+/// Writes `DEFAULT_SCENE_GLTF` to `file` in `dir` unless it holds it already, through a file
+/// of this process renamed into place, so that processes starting together never read half.
+fn write_once(dir: &Path, file: &Path) -> std::io::Result<()> {
+    if std::fs::read(file).is_ok_and(|text| text == DEFAULT_SCENE_GLTF.as_bytes()) {
+        return Ok(());
+    }
+    std::fs::create_dir_all(dir)?;
+    let temp = dir.join(format!("{}.tmp", std::process::id()));
+    std::fs::write(&temp, DEFAULT_SCENE_GLTF)?;
+    std::fs::rename(&temp, file)
 }
 
 /// A file shipped with the crate (`relative` to its root): from the working folder if it has

@@ -113,7 +113,7 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let path = args.scene.path();
+    let path = args.scene.path()?;
     let scene = load_with_options(&path, &args.scene.load_options(None))?;
     let settings = RenderSettings {
         width: args.size.width,
@@ -151,7 +151,7 @@ fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirS
     let spinner = compile_progress();
     let mut renderer = Restir::with_progress(scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
     spinner.finish_and_clear();
-    print_compile_summary(&renderer.compile_reports());
+    print_compile_summary(&renderer.compile_reports(), renderer.compile_ms(), renderer.compile_cpu_ms());
     let mut times = vec![];
     for f in 0..args.frames {
         let stats = if args.camera_path {

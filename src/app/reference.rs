@@ -51,7 +51,7 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
     if args.spp == 0 {
         bail!("--spp must be at least 1");
     }
-    let path = scene_path(Some(&args.scene));
+    let path = scene_path(Some(&args.scene))?;
     let scene = load_with_warnings(&path)?;
     let samples = shard.map(|s| s.samples(args.spp)).unwrap_or(0..args.spp);
     if samples.is_empty() {

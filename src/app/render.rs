@@ -1,21 +1,17 @@
 //! `restir-pt render`: ReSTIR PT frames or progressive path tracing to EXR/PNG, with a one-line
-//! summary per frame.
+//! summary per frame; its options and how long a run lasts (render_loop.rs runs the frames).
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
-use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 
 use super::args::{parse_exposure, DeviceArgs, PathArgs, RestirArgs, SceneArgs, Toggle};
-use super::render_output::{
-    check_extension, compile_progress, create_parent, guard_nonfinite, interrupt_flag, print_compile_summary, progress_bar, Outputs,
-    RenderReport, RestirFrameReport,
-};
+use super::render_loop::{render_path_traced, render_restir, Job};
+use super::render_output::{check_extension, create_parent, Outputs};
 use super::{finish_device, load_with_options, open_device};
 use restir_pt::image_io::Exposure;
-use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo};
+use restir_pt::render::{RenderSettings, RestirSettings, SceneGpu, SceneInfo};
 use restir_pt::scene::{camera_on_path, Scene};
 
 /// The rendering method.
@@ -34,8 +30,9 @@ pub struct RenderArgs {
     pub scene: SceneArgs,
     #[arg(long, value_enum, default_value_t = MethodArg::Restir)]
     pub method: MethodArg,
-    /// Path-tracer samples per pixel (default 64); only with --method pt. With --static-camera
-    /// and --frames F, each frame adds this many and the image holds all F times as many.
+    /// Path-tracer samples per pixel (default 64; with --time, 4 per step); only with --method pt.
+    /// With --static-camera and --frames F, each frame adds this many and the image holds all F
+    /// times as many.
     #[arg(long)]
     pub spp: Option<u32>,
     /// Image width; with --height alone it follows the camera's aspectRatio (default 256).
@@ -56,11 +53,17 @@ pub struct RenderArgs {
     /// --max-depth).
     #[arg(long, value_enum)]
     pub russian_roulette: Option<Toggle>,
-    /// Render F frames along the scene's camera path from --camera: its cameras in order, then
-    /// back and forth (0, 1, ..., n-1, n-2, ..., 0, 1, ...). The last frame goes to --out;
-    /// every frame too with --out-dir.
-    #[arg(long, default_value_t = 1)]
-    pub frames: u32,
+    /// Render exactly F frames along the scene's camera path from --camera: its cameras in
+    /// order, then back and forth (0, 1, ..., n-1, n-2, ..., 0, 1, ...). The last frame goes to
+    /// --out; every frame too with --out-dir. `--frames 1` is one frame. Without --frames,
+    /// ReSTIR PT renders to a time budget (--time) and the path tracer one frame of --spp.
+    #[arg(long, conflicts_with = "time")]
+    pub frames: Option<u32>,
+    /// Render frames of an unmoved camera (--camera) and write their average, until their GPU
+    /// time reaches SECONDS (default for ReSTIR PT without --frames: 8). The path tracer adds
+    /// --spp (default 4) per step.
+    #[arg(long, value_name = "SECONDS")]
+    pub time: Option<f64>,
     /// Render every frame from --camera and write the average of the frames (offline mode).
     #[arg(long)]
     pub static_camera: bool,
@@ -89,7 +92,38 @@ pub struct RenderArgs {
     pub device: DeviceArgs,
 }
 
+/// GPU seconds of frames that ReSTIR PT renders and averages without --frames or --time.
+pub const DEFAULT_TIME_S: f64 = 8.0;
+/// Path-tracer samples per pixel per step of a time budget, when --spp is not given.
+const BUDGET_STEP_SPP: u32 = 4;
+
+/// How long a render runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunLength {
+    /// Exactly this many frames (`--frames`).
+    Frames(u32),
+    /// Frames of an unmoved camera, averaged, until their GPU time reaches this many
+    /// milliseconds (`--time`): the frame that reaches it is the last.
+    GpuMs(f64),
+}
+
 impl RenderArgs {
+    /// How long the run lasts: `--frames`, else `--time`, else ReSTIR PT's default time budget
+    /// or the path tracer's one frame.
+    pub fn run_length(&self) -> RunLength {
+        match (self.frames, self.time) {
+            (Some(frames), _) => RunLength::Frames(frames),
+            (None, Some(seconds)) => RunLength::GpuMs(seconds * 1e3),
+            (None, None) if self.method == MethodArg::Restir => RunLength::GpuMs(DEFAULT_TIME_S * 1e3),
+            (None, None) => RunLength::Frames(1),
+        }
+    }
+
+    /// Whether every frame is seen from --camera: with --static-camera and under a time budget.
+    pub fn is_static(&self) -> bool {
+        self.static_camera || matches!(self.run_length(), RunLength::GpuMs(_))
+    }
+
     /// Every flag at its default: what `restir-pt` without a command renders.
     pub fn parse_defaults() -> Result<Self> {
         super::parse_args(&[])
@@ -105,7 +139,7 @@ impl RenderArgs {
         match self.method {
             MethodArg::Restir => {
                 if self.spp.is_some() {
-                    eprintln!("warning: --spp is ignored by ReSTIR PT, which renders --frames frames of --candidates paths per pixel (--method pt uses it)");
+                    eprintln!("warning: --spp is ignored by ReSTIR PT, which renders frames (--time or --frames) of --candidates paths per pixel (--method pt uses it)");
                 }
                 if self.russian_roulette == Some(Toggle::On) {
                     eprintln!("warning: --russian-roulette on is ignored by ReSTIR PT, which traces every path to --max-depth (--method pt uses it)");
@@ -185,7 +219,10 @@ impl RenderArgs {
             spp: self
                 .spp
                 .filter(|_| self.method == MethodArg::Pt)
-                .unwrap_or(RenderSettings::DEFAULT_SPP),
+                .unwrap_or(match self.run_length() {
+                    RunLength::GpuMs(_) => BUDGET_STEP_SPP,
+                    RunLength::Frames(_) => RenderSettings::DEFAULT_SPP,
+                }),
             max_depth: self.path.max_depth,
             seed: self.path.seed,
             russian_roulette: self.russian_roulette.is_none_or(Toggle::on),
@@ -195,8 +232,8 @@ impl RenderArgs {
 
     /// The scene camera of frame `frame`: --camera for a static camera, else the scene's camera
     /// path from --camera (`camera_on_path`).
-    fn frame_camera(&self, frame: u32, cameras: usize) -> usize {
-        if self.static_camera {
+    pub fn frame_camera(&self, frame: u32, cameras: usize) -> usize {
+        if self.is_static() {
             self.path.camera
         } else {
             camera_on_path(self.path.camera, frame, cameras)
@@ -204,8 +241,8 @@ impl RenderArgs {
     }
 
     /// "frame F | camera C | " for runs of several frames (the camera a frame's reference needs).
-    fn frame_prefix(&self, frame: u32, cameras: usize) -> String {
-        if self.frames > 1 {
+    pub fn frame_prefix(&self, frame: u32, cameras: usize) -> String {
+        if self.run_length() != RunLength::Frames(1) {
             format!("frame {frame} | camera {} | ", self.frame_camera(frame, cameras))
         } else {
             String::new()
@@ -238,77 +275,15 @@ fn output_paths(args: &RenderArgs, scene_path: &Path) -> Result<OutputPaths> {
     Ok(OutputPaths { out, png })
 }
 
-/// What both methods' frame loops need.
-struct Job<'a> {
-    /// The uploaded scene both renderers are built from.
-    scene: &'a Arc<SceneGpu>,
-    scene_path: &'a Path,
-    args: &'a RenderArgs,
-    settings: &'a RenderSettings,
-    outputs: Outputs<'a>,
-}
-
-impl Job<'_> {
-    /// Whether the run ends with `frame` (the last frame, or Ctrl-C).
-    fn is_last(&self, frame: u32, interrupted: bool) -> bool {
-        frame + 1 == self.args.frames || interrupted
-    }
-
-    /// Whether `frame`'s image is written: the last frame's, and every frame's with --out-dir.
-    fn writes_image(&self, frame: u32, interrupted: bool) -> bool {
-        self.args.out_dir.is_some() || self.is_last(frame, interrupted)
-    }
-
-    /// Prints the frame's line, refuses or warns about non-finite pixels and writes the frame's
-    /// image if it was read back (`writes_image`). Returns whether the run ends here.
-    fn finish_frame(
-        &self,
-        frame: u32,
-        report: &RenderReport,
-        line: &str,
-        image: Option<&restir_pt::render::Image>,
-        interrupted: bool,
-    ) -> Result<bool> {
-        println!("{}{line}", self.args.frame_prefix(frame, self.scene.info().cameras.len()));
-        guard_nonfinite(self.args.allow_nonfinite, self.args.report.as_deref(), frame, report)?;
-        let last = self.is_last(frame, interrupted);
-        if let Some(image) = image {
-            self.outputs.write_frame(frame, image)?;
-            if last {
-                self.outputs.write_final(image)?;
-            }
-        }
-        Ok(last)
-    }
-
-    fn report(&self, method: String, spp: u32, frame_ms: f64, wall_ms: f64, compile_ms: f64) -> RenderReport {
-        RenderReport {
-            device: self.scene.ctx().info.name.clone(),
-            scene: self.scene_path.display().to_string(),
-            method,
-            width: self.settings.width,
-            height: self.settings.height,
-            spp,
-            max_depth: self.settings.max_depth,
-            gpu_ms: frame_ms,
-            frame_gpu_ms: vec![frame_ms],
-            median_gpu_ms: frame_ms,
-            wall_ms,
-            paths_per_second: 0.0,
-            compile_ms,
-            nonfinite_pixels: 0,
-            nonfinite_weights: 0,
-            restir: None,
-        }
-    }
-}
-
 pub fn render(args: RenderArgs) -> Result<()> {
-    if args.frames == 0 {
+    if args.frames == Some(0) {
         bail!("--frames must be at least 1");
     }
+    if let Some(seconds) = args.time.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        bail!("--time {seconds}: give a positive number of seconds");
+    }
     args.warn_ignored_flags();
-    let path = args.scene.path();
+    let path = args.scene.path()?;
     args.check_before_device(&path)?;
     // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
@@ -317,7 +292,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if let Some(line) = scene.surface_summary() {
         eprintln!("{line}");
     }
-    if !args.static_camera && args.frames > 1 && scene.cameras.len() < 2 {
+    if !args.is_static() && args.frames.is_some_and(|f| f > 1) && scene.cameras.len() < 2 {
         eprintln!(
             "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",
             path.display()
@@ -338,6 +313,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
             out_dir: args.out_dir.as_deref(),
             exposure: args.exposure,
         },
+        run: args.run_length(),
     };
     let report = match args.restir_settings() {
         None => render_path_traced(&job)?,
@@ -356,99 +332,6 @@ pub fn render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Path-traced frames of --spp each. A moving camera restarts the sums at every frame; a static
-/// one keeps them, so that the image is the average of all frames (one render of F x spp).
-fn render_path_traced(job: &Job) -> Result<RenderReport> {
-    let (args, settings) = (job.args, job.settings);
-    let interrupt = interrupt_flag();
-    let spinner = compile_progress();
-    spinner.set_message("pathtrace.comp");
-    let mut tracer = PathTracer::new(job.scene, settings)?;
-    spinner.finish_and_clear();
-    let compile_ms = tracer.compile_report().total_ms();
-    print_compile_summary(std::slice::from_ref(tracer.compile_report()));
-    let (mut frame_ms, mut frame) = (vec![], 0);
-    loop {
-        if frame > 0 && args.static_camera {
-            tracer.add_samples(settings.spp);
-        } else if frame > 0 {
-            let camera = args.frame_camera(frame, job.scene.info().cameras.len());
-            tracer.restart(&RenderSettings {
-                camera,
-                ..settings.clone()
-            })?;
-        }
-        let bar = progress_bar(tracer.target_spp());
-        let stats = tracer.render(&|done| bar.set_position(done as u64), &interrupt)?;
-        bar.finish_and_clear();
-        let image = tracer.image()?;
-        frame_ms.push(stats.gpu_ms);
-        let mut report = job.report("pt".into(), stats.spp, stats.gpu_ms, stats.wall_ms, compile_ms);
-        report.set_frame_times(&frame_ms);
-        // A static camera's stats count every frame's samples; the throughput is this frame's.
-        let frame_spp = stats.spp.saturating_sub(if args.static_camera { frame * settings.spp } else { 0 });
-        report.paths_per_second = stats.paths_per_second(settings.pixel_count()) * frame_spp as f64 / stats.spp.max(1) as f64;
-        report.nonfinite_pixels = image.non_finite_count();
-        report.nonfinite_weights = stats.nonfinite_paths;
-        if stats.interrupted {
-            eprintln!("interrupted: writing the {} spp of frame {frame} accumulated so far", stats.spp);
-        }
-        if job.finish_frame(frame, &report, &report.summary_line(), Some(&image), stats.interrupted)? {
-            return Ok(report);
-        }
-        frame += 1;
-    }
-}
-
-/// ReSTIR PT frames; a static camera averages them (`Restir::frame`'s accumulate).
-fn render_restir(job: &Job, restir: &RestirSettings) -> Result<RenderReport> {
-    let (args, settings) = (job.args, job.settings);
-    let interrupt = interrupt_flag();
-    let spinner = compile_progress();
-    let mut renderer = Restir::with_progress(job.scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
-    spinner.finish_and_clear();
-    let compile_reports = renderer.compile_reports();
-    print_compile_summary(&compile_reports);
-    let compile_ms = compile_reports.iter().map(|k| k.total_ms()).sum();
-    let spp = restir.candidates * restir.reservoirs;
-    let (mut frame_ms, mut frame) = (vec![], 0);
-    loop {
-        let stats = renderer.frame(args.frame_camera(frame, job.scene.info().cameras.len()), args.static_camera)?;
-        let interrupted = interrupt.load(Ordering::Relaxed);
-        frame_ms.push(stats.gpu_ms().unwrap_or(stats.wall_ms));
-        let detail = RestirFrameReport::from_stats(frame + 1, &stats);
-        let mut report = job.report(restir.label(), spp, frame_ms[frame as usize], stats.wall_ms, compile_ms);
-        report.set_frame_times(&frame_ms);
-        report.paths_per_second = settings.pixel_count() as f64 * spp as f64 / (report.gpu_ms * 1e-3);
-        // The image is read back only when it is written or when the shading pass counted a
-        // non-finite pixel (then the host count is the one reported and guarded).
-        let image = if job.writes_image(frame, interrupted) || detail.nonfinite_pixels > 0 {
-            Some(renderer.image()?)
-        } else {
-            None
-        };
-        report.nonfinite_pixels = image.as_ref().map_or(0, |image| image.non_finite_count());
-        report.nonfinite_weights = detail.nonfinite_weights as u64;
-        let line = format!("{} | {}", report.summary_line(), detail.summary());
-        report.restir = Some(detail);
-        if interrupted {
-            eprintln!("interrupted: writing frame {frame}");
-        }
-        if job.finish_frame(frame, &report, &line, image.as_ref(), interrupted)? {
-            if frame > 0 {
-                let total: f64 = frame_ms.iter().sum();
-                eprintln!(
-                    "{} frames, {total:.1} ms of GPU time in all (median {:.1} ms per frame)",
-                    frame + 1,
-                    report.median_gpu_ms
-                );
-            }
-            return Ok(report);
-        }
-        frame += 1;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -456,12 +339,32 @@ mod tests {
     #[test]
     fn render_without_arguments_takes_the_library_defaults() {
         let args = RenderArgs::parse_defaults().unwrap();
-        assert_eq!((args.method, args.frames, args.static_camera), (MethodArg::Restir, 1, false));
+        assert_eq!((args.method, args.frames, args.static_camera), (MethodArg::Restir, None, false));
+        assert_eq!(args.run_length(), RunLength::GpuMs(DEFAULT_TIME_S * 1e3));
+        assert!(args.is_static());
         assert_eq!(args.path.max_depth, RenderSettings::DEFAULT_MAX_DEPTH);
         assert_eq!(args.restir_settings(), Some(RestirSettings::default()));
         assert_eq!(args.russian_roulette, None);
         let pt: RenderArgs = super::super::parse_args(&["--method", "pt", "--russian-roulette", "off", "--exposure", "-1.5"]).unwrap();
         assert_eq!((pt.restir_settings(), pt.russian_roulette), (None, Some(Toggle::Off)));
         assert_eq!(pt.exposure, Exposure::Ev(-1.5));
+        assert_eq!((pt.run_length(), pt.is_static()), (RunLength::Frames(1), false));
+        assert_eq!(pt.settings_of_size(8, 8).spp, RenderSettings::DEFAULT_SPP);
+    }
+
+    #[test]
+    fn frames_and_time_choose_the_run_length() {
+        let one: RenderArgs = super::super::parse_args(&["--frames", "1"]).unwrap();
+        assert_eq!((one.run_length(), one.is_static()), (RunLength::Frames(1), false));
+        let moving: RenderArgs = super::super::parse_args(&["--frames", "16"]).unwrap();
+        assert_eq!((moving.run_length(), moving.frame_camera(3, 8)), (RunLength::Frames(16), 3));
+        let timed: RenderArgs = super::super::parse_args(&["--time", "2.5", "--camera", "2"]).unwrap();
+        assert_eq!((timed.run_length(), timed.frame_camera(3, 8)), (RunLength::GpuMs(2500.0), 2));
+        let pt: RenderArgs = super::super::parse_args(&["--method", "pt", "--time", "1"]).unwrap();
+        assert_eq!(
+            (pt.run_length(), pt.settings_of_size(8, 8).spp),
+            (RunLength::GpuMs(1000.0), BUDGET_STEP_SPP)
+        );
+        assert!(super::super::parse_args::<RenderArgs>(&["--frames", "2", "--time", "1"]).is_err());
     }
 }

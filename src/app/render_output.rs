@@ -30,8 +30,12 @@ pub struct RenderReport {
     pub median_gpu_ms: f64,
     pub wall_ms: f64,
     pub paths_per_second: f64,
-    /// Start-up milliseconds spent compiling the kernels (outside every frame's time).
+    /// Start-up milliseconds spent compiling the kernels, wall-clock (outside every frame's time).
     pub compile_ms: f64,
+    /// The GPU time budget of the frames (`--time`, the default of ReSTIR PT), if the run had
+    /// one rather than a frame count.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_budget_ms: Option<f64>,
     /// NaN or infinite pixels of the image written (or refused) for this frame.
     pub nonfinite_pixels: usize,
     /// Path weights found NaN or infinite: the path tracer's paths with a non-finite radiance or
@@ -198,10 +202,26 @@ pub fn status_spinner() -> indicatif::ProgressBar {
     bar
 }
 
-/// The start-up line: how long compiling the kernels took.
-pub fn print_compile_summary(kernels: &[restir_pt::vk::KernelCompile]) {
-    let total: f64 = kernels.iter().map(|k| k.total_ms()).sum();
-    eprintln!("start-up: {} kernel(s) compiled in {total:.0} ms", kernels.len());
+/// The start-up line: how long compiling the kernels took, wall-clock (`wall_ms`) and in CPU
+/// time of the process (`cpu_ms`, which other processes do not inflate), and the GLSL stage's
+/// CPU time over all kernels (on worker threads, overlapping the driver's compiles).
+pub fn print_compile_summary(kernels: &[restir_pt::vk::KernelCompile], wall_ms: f64, cpu_ms: f64) {
+    let glsl: f64 = kernels.iter().map(|k| k.glsl_cpu_ms).sum();
+    eprintln!(
+        "start-up: {} kernel(s) compiled in {wall_ms:.0} ms ({cpu_ms:.0} ms of CPU time, {glsl:.0} of it GLSL to SPIR-V)",
+        kernels.len()
+    );
+}
+
+/// A bar of a render's GPU time budget, in milliseconds; its message counts the frames or
+/// samples so far.
+pub fn budget_bar(budget_ms: f64) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(budget_ms.max(1.0) as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {msg}  {elapsed} (eta {eta}; --time sets the budget)")
+            .expect("static template is valid"),
+    );
+    bar
 }
 
 /// A bar of samples per pixel done.

@@ -17,7 +17,7 @@ use crate::error::GpuError;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams};
 use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
-use crate::vk::{Binding, Context, Kernel, KernelCompile, PassTimer};
+use crate::vk::{compile_kernels_in_parallel, process_cpu_ms, Binding, Context, Kernel, KernelCompile, PassTimer};
 
 mod buffers;
 mod params;
@@ -80,8 +80,11 @@ impl FrameStats {
 /// temporal history and the running average of a static camera kept between frames.
 pub struct Restir {
     ctx: Arc<Context>,
-    /// The frame's kernels, indexed by `PassKernel as usize`.
-    kernels: Vec<Kernel>,
+    /// The frame's kernels, indexed by `PassKernel as usize`; None until built.
+    kernels: Vec<Option<Kernel>>,
+    /// Wall-clock and process CPU milliseconds spent building kernels (`compile_ms`).
+    compile_ms: f64,
+    compile_cpu_ms: f64,
     buffers: RestirBuffers,
     /// The image and the per-frame counters come back through it.
     readback: AccumReadback,
@@ -98,11 +101,11 @@ pub struct Restir {
 
 impl Restir {
     /// A ReSTIR PT renderer of the uploaded `scene` on its device: builds every kernel a run
-    /// can use and compiles them (see `warm_up`); the time that took is in `compile_reports`.
+    /// can use and compiles them (see `build`); the time that took is in `compile_reports`.
     /// Errors: settings invalid for the scene, too little shared memory, a failed allocation or
     /// compile.
     pub fn new(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirSettings) -> Result<Self> {
-        Self::with_progress(scene, settings, restir, &|_| {})
+        Self::with_kernels(scene, settings, restir, &PassKernel::ALL, &|_| {})
     }
 
     /// `new`, telling `progress` the name of each kernel before the driver compiles it.
@@ -110,6 +113,21 @@ impl Restir {
         scene: &Arc<SceneGpu>,
         settings: &RenderSettings,
         restir: &RestirSettings,
+        progress: &dyn Fn(&str),
+    ) -> Result<Self> {
+        Self::with_kernels(scene, settings, restir, &PassKernel::ALL, progress)
+    }
+
+    /// A renderer that builds only `kernels` at start-up (those a run will dispatch:
+    /// [`RestirSettings::kernels_for_cameras`]), compiling their GLSL on worker threads while
+    /// the driver compiles the ones ready (see `build`). A frame that needs a kernel left out
+    /// builds it before it is recorded, outside the frame's GPU time; the images are the same
+    /// either way. `progress` hears each kernel's name before the driver compiles it.
+    pub fn with_kernels(
+        scene: &Arc<SceneGpu>,
+        settings: &RenderSettings,
+        restir: &RestirSettings,
+        kernels: &[PassKernel],
         progress: &dyn Fn(&str),
     ) -> Result<Self> {
         let ctx = scene.ctx();
@@ -123,14 +141,15 @@ impl Restir {
             );
         }
         let buffers = RestirBuffers::new(ctx, settings.pixel_count() as u64, restir.reservoirs)?;
-        let scene_gpu = scene.clone();
         let stats_bytes = std::mem::size_of::<RestirStats>() as u64;
         let mut renderer = Self {
             ctx: ctx.clone(),
-            kernels: build_kernels(&scene_gpu, restir)?,
+            kernels: PassKernel::ALL.iter().map(|_| None).collect(),
+            compile_ms: 0.0,
+            compile_cpu_ms: 0.0,
             buffers,
             readback: AccumReadback::new(ctx, settings.width, settings.height, stats_bytes)?,
-            scene_gpu,
+            scene_gpu: scene.clone(),
             timer: PassTimer::new(ctx, PASS_NAMES.len() as u32)?,
             settings: settings.clone(),
             restir: restir.clone(),
@@ -139,15 +158,26 @@ impl Restir {
             history: None,
             surface_slot: 0,
         };
-        renderer.bind_buffers()?;
-        renderer.warm_up(progress)?;
+        renderer.build(kernels, progress)?;
         Ok(renderer)
     }
 
-    /// Dispatches every kernel once over an image of zero pixels, which writes nothing: llvmpipe
-    /// compiles a kernel at its first dispatch, and that compile belongs to start-up, not to a
-    /// frame's GPU time.
-    fn warm_up(&mut self, progress: &dyn Fn(&str)) -> Result<()> {
+    /// Builds those of `wanted` not built yet: their GLSL compiled on worker threads
+    /// (`compile_kernels_in_parallel`), each pipeline created, bound and dispatched once over
+    /// an image of zero pixels (which writes nothing) on this thread as soon as its SPIR-V is
+    /// ready. llvmpipe compiles a kernel at its first dispatch, and that compile belongs to
+    /// start-up, not to a frame's GPU time.
+    fn build(&mut self, wanted: &[PassKernel], progress: &dyn Fn(&str)) -> Result<()> {
+        let (start, cpu) = (Instant::now(), process_cpu_ms());
+        let mut todo: Vec<PassKernel> = Vec::new();
+        for &k in wanted {
+            if self.kernels[k as usize].is_none() && !todo.contains(&k) {
+                todo.push(k);
+            }
+        }
+        if todo.is_empty() {
+            return Ok(());
+        }
         let empty = FrameParams {
             width: 0,
             height: 0,
@@ -155,29 +185,61 @@ impl Restir {
         };
         self.buffers.params.write(std::slice::from_ref(&empty))?;
         self.buffers.reuse.write(std::slice::from_ref(&ReuseParams::default()))?;
-        for kernel in &mut self.kernels {
-            progress(&kernel.compile_report().name);
-            kernel
-                .warm_up(&0u32.to_ne_bytes())
-                .with_context(|| format!("compiling {}", kernel.name))?;
-        }
+        let scene_gpu = self.scene_gpu.clone();
+        let mut layout = scene_gpu.bindings();
+        layout.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
+        let mut defines = scene_gpu.defines();
+        defines.extend(self.restir.defines());
+        let jobs: Vec<(&str, Vec<(&str, &str)>)> = todo
+            .iter()
+            .map(|k| {
+                let (file, extra) = k.source();
+                (file, defines.iter().chain(extra).copied().collect())
+            })
+            .collect();
+        compile_kernels_in_parallel(&jobs, |i, compiled| {
+            let kernel = todo[i];
+            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, &compiled, layout.clone(), 4)?;
+            if kernel == PassKernel::TemporalUnmoved {
+                k.set_variant("(unmoved camera)");
+            }
+            progress(&format!("{} ({}/{})", k.compile_report().name, i + 1, todo.len()));
+            k.bind(&self.buffers.binding_table(&scene_gpu))?;
+            k.warm_up(&0u32.to_ne_bytes()).with_context(|| format!("compiling {}", k.name))?;
+            self.kernels[kernel as usize] = Some(k);
+            Ok(())
+        })?;
+        self.compile_ms += start.elapsed().as_secs_f64() * 1e3;
+        self.compile_cpu_ms += process_cpu_ms() - cpu;
         Ok(())
     }
 
-    /// What building and compiling each kernel cost (one entry per kernel).
-    pub fn compile_reports(&self) -> Vec<KernelCompile> {
-        self.kernels.iter().map(|k| k.compile_report().clone()).collect()
+    /// The kernels built so far, in frame order.
+    fn built(&self) -> impl Iterator<Item = &Kernel> {
+        self.kernels.iter().flatten()
     }
 
-    /// Milliseconds of start-up spent compiling kernels, over all kernels.
+    /// What building and compiling each kernel cost (one entry per kernel built so far).
+    pub fn compile_reports(&self) -> Vec<KernelCompile> {
+        self.built().map(|k| k.compile_report().clone()).collect()
+    }
+
+    /// Wall-clock milliseconds spent building kernels, start-up and any kernel a frame needed
+    /// later. Below the sum of the reports' stages where GLSL compiled on other threads.
     pub fn compile_ms(&self) -> f64 {
-        self.kernels.iter().map(|k| k.compile_report().total_ms()).sum()
+        self.compile_ms
+    }
+
+    /// CPU milliseconds of the whole process while it built kernels (every thread: GLSL
+    /// workers, the driver's), which other processes on the machine do not inflate.
+    pub fn compile_cpu_ms(&self) -> f64 {
+        self.compile_cpu_ms
     }
 
     /// Points every kernel's descriptors at the current buffers, by binding name.
     fn bind_buffers(&self) -> Result<()> {
         let table = self.buffers.binding_table(&self.scene_gpu);
-        for kernel in &self.kernels {
+        for kernel in self.built() {
             kernel.bind(&table)?;
         }
         Ok(())
@@ -223,6 +285,8 @@ impl Restir {
         settings.validate(self.scene_gpu.info())?;
         let frame_params = settings.frame_params(self.scene_gpu.info());
         let plan = self.plan(&frame_params);
+        let needed: Vec<PassKernel> = plan.passes.iter().map(|p| p.kernel).collect();
+        self.build(&needed, &|_| {})?;
         self.write_params(&frame_params, &plan, accumulate)?;
         self.ctx
             .submit_and_wait(|cmd| self.record_frame(cmd, &plan, accumulate))
@@ -279,24 +343,4 @@ impl Restir {
     pub fn image(&self) -> Result<Image> {
         Ok(self.readback.image(&self.buffers.accum, &self.buffers.accum_sq)?)
     }
-}
-
-/// Every kernel a frame may run, indexed by `PassKernel as usize`, built for the scene's
-/// bindings and defines and for the shift and MIS of `restir`.
-fn build_kernels(scene_gpu: &SceneGpu, restir: &RestirSettings) -> Result<Vec<Kernel>> {
-    let mut layout = scene_gpu.bindings();
-    layout.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
-    let mut defines = scene_gpu.defines();
-    defines.extend(restir.defines());
-    let mut kernels = Vec::with_capacity(PassKernel::ALL.len());
-    for kernel in PassKernel::ALL {
-        let (file, extra) = kernel.source();
-        let all: Vec<_> = defines.iter().chain(extra).copied().collect();
-        let mut k = scene_gpu.kernel(file, &all, layout.clone(), 4)?;
-        if kernel == PassKernel::TemporalUnmoved {
-            k.set_variant("(unmoved camera)");
-        }
-        kernels.push(k);
-    }
-    Ok(kernels)
 }

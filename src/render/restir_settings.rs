@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Result};
 
-use super::frame_plan::History;
+use super::frame_plan::{History, PassKernel};
 use crate::shading::path_record::MAX_PATH_LENGTH;
 
 /// The shift mapping used for reuse (and, inverted, for its MIS weights). The discriminant is
@@ -212,6 +212,28 @@ impl RestirSettings {
         } else {
             self.rounds
         }
+    }
+
+    /// The kernels a run dispatches whose frames are seen from the scene cameras `cameras`, in
+    /// order: initial candidates and shading always, spatial reuse when on, and from the second
+    /// frame on, with temporal reuse, the unmoved-camera variant where a frame keeps the
+    /// previous frame's camera and the shifting one where it changes. Two cameras of one pose
+    /// are told apart here but not by the frames, which build the kernel they need then.
+    pub fn kernels_for_cameras(&self, cameras: &[usize]) -> Vec<PassKernel> {
+        let mut kernels = vec![PassKernel::Initial];
+        if self.temporal {
+            if cameras.windows(2).any(|w| w[0] == w[1]) {
+                kernels.push(PassKernel::TemporalUnmoved);
+            }
+            if cameras.windows(2).any(|w| w[0] != w[1]) {
+                kernels.push(PassKernel::Temporal);
+            }
+        }
+        if self.spatial_rounds() > 0 {
+            kernels.push(PassKernel::Spatial);
+        }
+        kernels.push(PassKernel::Shade);
+        kernels
     }
 
     /// The `#define`s that select the shift and the MIS in the reuse kernels.

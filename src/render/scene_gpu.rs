@@ -18,7 +18,7 @@ use crate::scene::Scene;
 use crate::shader_interface::SceneBinding;
 use crate::shading::bsdf::{has_specular_layer, lobe_weights};
 use crate::shading::texture::NO_TEXTURE;
-use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context, Kernel};
+use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, CompiledKernel, Context, Kernel};
 
 use super::surface_gpu::SurfaceGpu;
 use super::SceneInfo;
@@ -196,6 +196,17 @@ impl SceneGpu {
     /// Builds scene kernel glsl/`name` with set 0 `set0` (bound by the caller) and binds set 1.
     pub fn kernel(&self, name: &str, defines: &[(&str, &str)], set0: Vec<BindingSlot>, push_bytes: u32) -> Result<Kernel> {
         let kernel = Kernel::new(&self.ctx, name, defines, &self.layout(set0), push_bytes)?;
+        self.bind_surface(kernel)
+    }
+
+    /// `kernel` from SPIR-V compiled elsewhere (`compile_kernels_in_parallel`).
+    pub fn kernel_with_spirv(&self, name: &str, compiled: &CompiledKernel, set0: Vec<BindingSlot>, push_bytes: u32) -> Result<Kernel> {
+        let kernel = Kernel::with_spirv(&self.ctx, name, compiled, &self.layout(set0), push_bytes)?;
+        self.bind_surface(kernel)
+    }
+
+    /// Binds set 1, the surface attributes and textures, if the scene has them.
+    fn bind_surface(&self, kernel: Kernel) -> Result<Kernel> {
         if let Some(s) = &self.surface {
             kernel.bind(&s.bound())?;
         }

@@ -8,7 +8,8 @@ use anyhow::{Context as _, Result};
 use ash::vk;
 
 use super::reflect::check_bindings;
-use super::{compile_kernel, Buffer, Context};
+use super::shader::{compile_timed, process_cpu_ms, CompiledKernel};
+use super::{Buffer, Context};
 use crate::error::{vk_error, GpuError};
 
 /// The descriptor kind of a buffer binding.
@@ -69,8 +70,10 @@ impl Binding {
     }
 }
 
-/// What building one kernel cost, in wall-clock milliseconds per stage. Drivers may compile at
-/// pipeline creation or at the first dispatch (llvmpipe JIT-compiles there), so both count.
+/// What building one kernel cost, in wall-clock milliseconds per stage, and in CPU milliseconds
+/// (which other processes on the machine do not inflate).
+/// Drivers may compile at pipeline creation or at the first dispatch (llvmpipe JIT-compiles
+/// there), so both count.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct KernelCompile {
     /// The GLSL file and its variant, e.g. "restir_temporal.comp (unmoved camera)".
@@ -83,12 +86,26 @@ pub struct KernelCompile {
     pub pipeline_ms: f64,
     /// The first dispatch of one workgroup (see `Kernel::warm_up`), 0 before it.
     pub first_dispatch_ms: f64,
+    /// CPU milliseconds of the GLSL to SPIR-V stage on the thread that compiled it.
+    pub glsl_cpu_ms: f64,
+    /// CPU milliseconds of the process in vkCreateComputePipelines: the driver's alone when
+    /// nothing else runs in the process (`set_compile_threads(0)`), else with the GLSL
+    /// compiles of other kernels on worker threads meanwhile.
+    pub pipeline_cpu_ms: f64,
+    /// CPU milliseconds of the process in the first dispatch (lavapipe compiles on its queue
+    /// thread, not the caller's), counted as `pipeline_cpu_ms` is.
+    pub first_dispatch_cpu_ms: f64,
 }
 
 impl KernelCompile {
     /// The sum of the three stages, in milliseconds.
     pub fn total_ms(&self) -> f64 {
         self.glsl_ms + self.pipeline_ms + self.first_dispatch_ms
+    }
+
+    /// The sum of the three stages' CPU time, in milliseconds.
+    pub fn total_cpu_ms(&self) -> f64 {
+        self.glsl_cpu_ms + self.pipeline_cpu_ms + self.first_dispatch_cpu_ms
     }
 }
 
@@ -116,19 +133,28 @@ impl Kernel {
     /// Builds the kernel glsl/`name` with the bindings `layout` (of any sets). Fails when the
     /// compiled shader declares a binding that `layout` lacks or names differently.
     pub fn new(ctx: &Arc<Context>, name: &str, defines: &[(&str, &str)], layout: &[BindingSlot], push_bytes: u32) -> Result<Self> {
-        let start = Instant::now();
-        let spirv = compile_kernel(name, defines)?;
-        let glsl_ms = start.elapsed().as_secs_f64() * 1e3;
-        check_bindings(name, &spirv, layout).map_err(anyhow::Error::msg)?;
-        let start = Instant::now();
+        let compiled = compile_timed(name, defines)?;
+        Self::with_spirv(ctx, name, &compiled, layout, push_bytes)
+    }
+
+    /// Builds the kernel glsl/`name` from its SPIR-V, compiled elsewhere (e.g. by
+    /// `compile_kernels_in_parallel`), whose cost goes to the GLSL stage of its report. Fails as
+    /// `new` does when the layout does not match the shader's bindings.
+    pub fn with_spirv(ctx: &Arc<Context>, name: &str, compiled: &CompiledKernel, layout: &[BindingSlot], push_bytes: u32) -> Result<Self> {
+        let spirv = &compiled.spirv;
+        check_bindings(name, spirv, layout).map_err(anyhow::Error::msg)?;
+        let (start, cpu) = (Instant::now(), process_cpu_ms());
         let mut kernel =
-            Self::from_spirv(ctx, name, &spirv, layout, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
+            Self::from_spirv(ctx, name, spirv, layout, push_bytes).with_context(|| format!("creating the compute pipeline {name}"))?;
         kernel.compile = KernelCompile {
             name: name.to_string(),
             spirv_bytes: spirv.len() * 4,
-            glsl_ms,
+            glsl_ms: compiled.wall_ms,
             pipeline_ms: start.elapsed().as_secs_f64() * 1e3,
             first_dispatch_ms: 0.0,
+            glsl_cpu_ms: compiled.cpu_ms,
+            pipeline_cpu_ms: process_cpu_ms() - cpu,
+            first_dispatch_cpu_ms: 0.0,
         };
         Ok(kernel)
     }
@@ -148,9 +174,10 @@ impl Kernel {
     /// `compile_report().first_dispatch_ms`. The caller makes the dispatch harmless, e.g. with
     /// an image size of zero in the bound parameters.
     pub fn warm_up(&mut self, push: &[u8]) -> Result<(), GpuError> {
-        let start = Instant::now();
+        let (start, cpu) = (Instant::now(), process_cpu_ms());
         self.run_1d(1, 1, push)?;
         self.compile.first_dispatch_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.compile.first_dispatch_cpu_ms = process_cpu_ms() - cpu;
         Ok(())
     }
 

@@ -12,6 +12,9 @@ pub use buffer::{Buffer, BufferUsage};
 pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
 pub use kernel::{record_compute_barrier, record_host_read_barrier, Binding, BindingSlot, BoundBuffer, Kernel, KernelCompile};
 pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};
-pub use shader::{compile_kernel, compile_kernel_cached_in, glsl_source};
+pub use shader::{
+    compile_kernel, compile_kernel_cached_in, compile_kernels_in_parallel, glsl_source, process_cpu_ms, set_compile_threads, thread_cpu_ms,
+    CompiledKernel,
+};
 pub use spirv_cache::{cache_dir as spirv_cache_dir, SPIRV_CACHE_ENV};
 pub use timer::PassTimer;

@@ -2,7 +2,9 @@
 
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::{Mutex, OnceLock};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{mpsc, Mutex, OnceLock};
+use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 
@@ -70,6 +72,107 @@ pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> 
         c.insert(key, spirv.clone());
     }
     Ok(spirv)
+}
+
+/// One kernel's SPIR-V from [`compile_kernels_in_parallel`], with what compiling it cost.
+pub struct CompiledKernel {
+    /// The SPIR-V words.
+    pub spirv: Vec<u32>,
+    /// Wall-clock milliseconds of `compile_kernel` on its thread (0-ish from a cache).
+    pub wall_ms: f64,
+    /// CPU milliseconds its thread spent in `compile_kernel`, which other processes do not
+    /// inflate as they do the wall-clock time.
+    pub cpu_ms: f64,
+}
+
+/// The CPU time of the calling thread, in milliseconds (0 where the clock is unavailable).
+pub fn thread_cpu_ms() -> f64 {
+    let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: clock_gettime writes one timespec through a valid pointer.
+    if unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) } != 0 {
+        return 0.0;
+    }
+    t.tv_sec as f64 * 1e3 + t.tv_nsec as f64 * 1e-6
+}
+
+/// The CPU time of the whole process, in milliseconds (0 where the clock is unavailable).
+pub fn process_cpu_ms() -> f64 {
+    let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: clock_gettime writes one timespec through a valid pointer.
+    if unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) } != 0 {
+        return 0.0;
+    }
+    t.tv_sec as f64 * 1e3 + t.tv_nsec as f64 * 1e-6
+}
+
+/// Worker threads of `compile_kernels_in_parallel`; `usize::MAX` stands for one per core.
+static COMPILE_THREADS: AtomicUsize = AtomicUsize::new(usize::MAX);
+
+/// Sets how many worker threads `compile_kernels_in_parallel` compiles GLSL on: 0 compiles
+/// each kernel on the calling thread just before it is consumed, so that nothing else runs in
+/// the process while the driver compiles and each stage's process CPU time is its own (what
+/// `restir-pt info --kernels` reports).
+pub fn set_compile_threads(threads: usize) {
+    COMPILE_THREADS.store(threads, Ordering::Relaxed);
+}
+
+/// Compiles `name` with `defines`, timed on the calling thread.
+pub(super) fn compile_timed(name: &str, defines: &[(&str, &str)]) -> Result<CompiledKernel> {
+    let (start, cpu) = (Instant::now(), thread_cpu_ms());
+    let spirv = compile_kernel(name, defines)?;
+    Ok(CompiledKernel {
+        spirv,
+        wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        cpu_ms: thread_cpu_ms() - cpu,
+    })
+}
+
+/// Compiles the kernels `jobs` (a path under glsl/ and its defines, as `compile_kernel` takes
+/// them) on worker threads, one per core, taking them in order, and hands each result to
+/// `consume` on the calling thread in the order of `jobs` as soon as it is ready. shaderc
+/// compiles on one core; so the calling thread can build the driver's pipeline of kernel i
+/// (llvmpipe: another single-threaded compile) while the workers compile kernels i+1 onwards.
+/// Stops at the first error of `consume` or of a compile.
+pub fn compile_kernels_in_parallel(
+    jobs: &[(&str, Vec<(&str, &str)>)],
+    mut consume: impl FnMut(usize, CompiledKernel) -> Result<()>,
+) -> Result<()> {
+    let workers = match COMPILE_THREADS.load(Ordering::Relaxed) {
+        usize::MAX => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    };
+    if workers == 0 {
+        return jobs
+            .iter()
+            .enumerate()
+            .try_for_each(|(i, (name, defines))| consume(i, compile_timed(name, defines)?));
+    }
+    let workers = workers.min(jobs.len());
+    let next = AtomicUsize::new(0);
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let (senders, receivers): (Vec<_>, Vec<_>) = jobs.iter().map(|_| mpsc::channel::<Result<CompiledKernel>>()).unzip();
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= jobs.len() || stop.load(Ordering::Relaxed) {
+                    break;
+                }
+                let (name, defines) = &jobs[i];
+                let result = compile_timed(name, defines);
+                // The receiver is gone only when the caller has stopped.
+                let _ = senders[i].send(result);
+            });
+        }
+        let result = receivers.iter().enumerate().try_for_each(|(i, receiver)| {
+            let compiled = receiver
+                .recv()
+                .map_err(|_| anyhow!("the compile thread of {} stopped", jobs[i].0))??;
+            consume(i, compiled)
+        });
+        stop.store(true, Ordering::Relaxed);
+        result
+    })
 }
 
 /// `compile_kernel` through the on-disk cache in `dir` alone: the SPIR-V, and whether it came

@@ -174,6 +174,8 @@ fn cli_nonfinite_pixels_fail_the_render_unless_allowed() {
         ];
         if method == "pt" {
             args.extend(["--spp", "4"]);
+        } else {
+            args.extend(["--frames", "1"]);
         }
         assert_clean_failure(&args, &["non-finite pixels", "--allow-nonfinite"]);
         assert!(!exr.exists(), "{method}: an image with non-finite pixels was written");

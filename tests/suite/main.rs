@@ -47,6 +47,7 @@ mod shift_oracle;
 mod specular_layer;
 mod speed_accuracy;
 mod spirv_cache;
+mod startup;
 mod statistics;
 mod surface_oracle;
 mod sweeps;

@@ -116,7 +116,10 @@ fn real_scenes_env_file_loads_exr_and_hdr_and_renders_with_both_methods() {
             "--env {value:?}: {stderr}"
         );
     }
-    for method in [["--method", "pt", "--spp", "8"].as_slice(), &["--method", "restir"]] {
+    for method in [
+        ["--method", "pt", "--spp", "8"].as_slice(),
+        &["--method", "restir", "--frames", "1"],
+    ] {
         let out = dir.join("env-render.exr");
         let mut args = vec![
             "render",

@@ -72,7 +72,7 @@ fn real_scenes_shared_assets_render_with_restir() {
         let name = f.file_name().unwrap().to_string_lossy();
         ["Mesh_PrimitiveMode_00.gltf", "Avocado.gltf"].contains(&name.as_ref())
     }) {
-        render_asset(file, &["--method", "restir"]);
+        render_asset(file, &["--method", "restir", "--frames", "1"]);
     }
 }
 
@@ -80,6 +80,6 @@ fn real_scenes_shared_assets_render_with_restir() {
 #[ignore = "compiles ReSTIR PT kernels for each of ~29 files (about 20 minutes on lavapipe)"]
 fn real_scenes_every_shared_asset_renders_with_restir() {
     for file in shared_assets() {
-        render_asset(&file, &["--method", "restir"]);
+        render_asset(&file, &["--method", "restir", "--frames", "1"]);
     }
 }

@@ -46,7 +46,9 @@ impl Restir {
             self.settings.height.div_ceil(LOCAL_SIZE),
             reservoirs,
         ];
-        self.kernels[pass.kernel as usize].record_dispatch(cmd, groups, &index.to_ne_bytes());
+        // `frame` builds every kernel of its plan before recording it.
+        let kernel = self.kernels[pass.kernel as usize].as_ref().expect("the frame's kernels are built");
+        kernel.record_dispatch(cmd, groups, &index.to_ne_bytes());
         record_compute_barrier(&self.ctx.device, cmd);
     }
 
