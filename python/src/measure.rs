@@ -95,7 +95,10 @@ fn flip<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let (w, h, x, r) = pair(image, reference)?;
     if !(pixels_per_degree.is_finite() && pixels_per_degree > 0.0) {
-        return Err(error_of(Kind::Settings, format!("pixels_per_degree {pixels_per_degree} must be positive")));
+        return Err(error_of(
+            Kind::Settings,
+            format!("pixels_per_degree {pixels_per_degree} must be positive"),
+        ));
     }
     let ev = match exposure {
         Some(ev) if ev.is_finite() => ev,
@@ -191,12 +194,18 @@ fn reference<'py>(
         return Err(error_of(Kind::Settings, "--spp must be at least 1".into()));
     }
     if shard.is_some() && out.is_none() {
-        return Err(error_of(Kind::Settings, "a shard needs out=, the shard file merge_shards reads".into()));
+        return Err(error_of(
+            Kind::Settings,
+            "a shard needs out=, the shard file merge_shards reads".into(),
+        ));
     }
     let samples = shard.map(|s| s.samples(spp)).unwrap_or(0..spp);
     if samples.is_empty() {
         let count = shard.map_or(1, |s| s.count);
-        return Err(error_of(Kind::Settings, format!("--spp {spp} cannot be cut into {count} shards: each needs at least 1 sample")));
+        return Err(error_of(
+            Kind::Settings,
+            format!("--spp {spp} cannot be cut into {count} shards: each needs at least 1 sample"),
+        ));
     }
     let settings = RenderSettings {
         width,
@@ -216,7 +225,7 @@ fn reference<'py>(
     if let Some(out) = &out {
         let source = scene.gpu.info().source.clone();
         let written = match shard {
-            Some(s) => tracer.sums().map_err(anyhow::Error::from).and_then(|(sums, sums_sq)| {
+            Some(s) => tracer.sums().and_then(|(sums, sums_sq)| {
                 let meta = ShardMeta {
                     scene: source.display().to_string(),
                     width,
@@ -251,8 +260,16 @@ fn merge_shards<'py>(py: Python<'py>, paths: Vec<PathBuf>, out: Option<PathBuf>)
     let (merged, missing) = without_gil(py, || merge_shard_files(&paths)).map_err(|e| py_error(Kind::Other, e))?;
     let meta = &merged.meta;
     if !missing.is_empty() {
-        let text = format!("shards {missing:?} of {} are missing: the reference has {} of {} spp", meta.shards, meta.spp, meta.total_spp);
-        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &std::ffi::CString::new(text).expect("no NUL"), 1)?;
+        let text = format!(
+            "shards {missing:?} of {} are missing: the reference has {} of {} spp",
+            meta.shards, meta.spp, meta.total_spp
+        );
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(text).expect("no NUL"),
+            1,
+        )?;
     }
     let image = Image::from_sums(meta.width, meta.height, &merged.sums, &merged.sums_sq);
     if let Some(out) = &out {

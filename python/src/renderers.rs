@@ -11,8 +11,7 @@ use pyo3::types::PyDict;
 use crate::scene::{PyCamera, PyUploadedScene};
 use crate::{check_signals, error_of, py_error, to_array, without_gil, Kind, OnThisThread};
 use restir_pt::render::{
-    FrameStats, History, PathTracer, RenderSettings, RenderStats, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind,
-    PASS_NAMES,
+    FrameStats, History, PathTracer, RenderSettings, RenderStats, Restir, RestirSettings, ReuseMis, SceneGpu, ShiftKind, PASS_NAMES,
 };
 use restir_pt::scene::Camera;
 
@@ -56,7 +55,9 @@ enum FrameCamera {
 }
 
 fn frame_camera(camera: Option<&Bound<'_, PyAny>>, default: usize, gpu: &SceneGpu) -> PyResult<FrameCamera> {
-    let Some(camera) = camera else { return Ok(FrameCamera::Index(default)) };
+    let Some(camera) = camera else {
+        return Ok(FrameCamera::Index(default));
+    };
     if let Ok(pose) = camera.extract::<PyRef<PyCamera>>() {
         return Ok(FrameCamera::Pose(pose.camera.clone()));
     }
@@ -67,7 +68,10 @@ fn frame_camera(camera: Option<&Bound<'_, PyAny>>, default: usize, gpu: &SceneGp
     if index >= count {
         return Err(error_of(
             Kind::Settings,
-            format!("{}: --camera {index} does not exist; the scene has {count} camera(s)", gpu.info().source.display()),
+            format!(
+                "{}: --camera {index} does not exist; the scene has {count} camera(s)",
+                gpu.info().source.display()
+            ),
         ));
     }
     Ok(FrameCamera::Index(index))
@@ -265,7 +269,10 @@ impl PyPathTracer {
 
     fn __repr__(&self) -> String {
         let s = &self.settings;
-        format!("PathTracer({}x{}, spp={}, max_depth={}, seed={})", s.width, s.height, s.spp, s.max_depth, s.seed)
+        format!(
+            "PathTracer({}x{}, spp={}, max_depth={}, seed={})",
+            s.width, s.height, s.spp, s.max_depth, s.seed
+        )
     }
 }
 
@@ -342,7 +349,16 @@ impl PyRestir {
         normal_threshold: f32,
         depth_threshold: f32,
     ) -> PyResult<Self> {
-        let settings = render_settings(&scene.gpu, width, height, RenderSettings::DEFAULT_SPP, max_depth, seed, true, camera)?;
+        let settings = render_settings(
+            &scene.gpu,
+            width,
+            height,
+            RenderSettings::DEFAULT_SPP,
+            max_depth,
+            seed,
+            true,
+            camera,
+        )?;
         let restir = RestirSettings {
             shift: parse_enum("shift", shift, &ShiftKind::ALL, ShiftKind::name)?,
             mis: parse_enum("mis", mis, &ReuseMis::ALL, ReuseMis::name)?,
@@ -359,10 +375,16 @@ impl PyRestir {
             depth_threshold,
         };
         restir.validate(settings.max_depth).map_err(|e| py_error(Kind::Settings, e))?;
-        if !(normal_threshold.is_finite() && (-1.0..=1.0).contains(&normal_threshold)) || !(depth_threshold.is_finite() && depth_threshold >= 0.0) {
+        let thresholds_ok = normal_threshold.is_finite()
+            && (-1.0..=1.0).contains(&normal_threshold)
+            && depth_threshold.is_finite()
+            && depth_threshold >= 0.0;
+        if !thresholds_ok {
             return Err(error_of(
                 Kind::Settings,
-                format!("normal_threshold {normal_threshold} must be in [-1, 1] and depth_threshold {depth_threshold} finite and non-negative"),
+                format!(
+                    "normal_threshold {normal_threshold} must be in [-1, 1] and depth_threshold {depth_threshold} finite and non-negative"
+                ),
             ));
         }
         let gpu = scene.gpu.clone();
@@ -423,7 +445,9 @@ impl PyRestir {
             let camera = match &cameras {
                 Some(list) => list[f as usize].clone(),
                 None if static_camera => self.settings.camera.into_pyobject(py)?.into_any(),
-                None => restir_pt::scene::camera_on_path(self.settings.camera, f, n).into_pyobject(py)?.into_any(),
+                None => restir_pt::scene::camera_on_path(self.settings.camera, f, n)
+                    .into_pyobject(py)?
+                    .into_any(),
             };
             out.push(self.frame(py, Some(&camera), static_camera)?);
         }
@@ -491,6 +515,13 @@ impl PyRestir {
 
     fn __repr__(&self) -> String {
         let s = &self.settings;
-        format!("Restir({}x{}, {}, max_depth={}, seed={})", s.width, s.height, self.restir.label(), s.max_depth, s.seed)
+        format!(
+            "Restir({}x{}, {}, max_depth={}, seed={})",
+            s.width,
+            s.height,
+            self.restir.label(),
+            s.max_depth,
+            s.seed
+        )
     }
 }

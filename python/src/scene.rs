@@ -38,10 +38,16 @@ fn environment(env: Option<&Bound<'_, PyAny>>) -> PyResult<(Option<Vec3>, Option
         return Ok((None, Some(path)));
     }
     let rgb: [f32; 3] = env.extract().map_err(|_| {
-        error_of(Kind::Settings, "env takes (r, g, b), three finite, non-negative radiances, or the path of an .exr or .hdr map".into())
+        error_of(
+            Kind::Settings,
+            "env takes (r, g, b), three finite, non-negative radiances, or the path of an .exr or .hdr map".into(),
+        )
     })?;
     if rgb.iter().any(|c| !c.is_finite() || *c < 0.0) {
-        return Err(error_of(Kind::Settings, format!("env {rgb:?}: radiances must be finite and non-negative")));
+        return Err(error_of(
+            Kind::Settings,
+            format!("env {rgb:?}: radiances must be finite and non-negative"),
+        ));
     }
     Ok((Some(Vec3::from_array(rgb)), None))
 }
@@ -198,7 +204,10 @@ impl PyCamera {
 
     fn __repr__(&self) -> String {
         let c = &self.camera;
-        format!("Camera({:?}, position={}, forward={}, yfov={})", c.name, c.position, c.forward, c.yfov)
+        format!(
+            "Camera({:?}, position={}, forward={}, yfov={})",
+            c.name, c.position, c.forward, c.yfov
+        )
     }
 }
 
@@ -207,7 +216,10 @@ impl PyCamera {
 #[pyfunction]
 fn camera_on_path(start: usize, frame: u32, cameras: usize) -> PyResult<usize> {
     if cameras == 0 || start >= cameras {
-        return Err(error_of(Kind::Settings, format!("camera {start} does not exist; the path has {cameras} camera(s)")));
+        return Err(error_of(
+            Kind::Settings,
+            format!("camera {start} does not exist; the path has {cameras} camera(s)"),
+        ));
     }
     Ok(restir_pt::scene::camera_on_path(start, frame, cameras))
 }

@@ -96,7 +96,8 @@ impl Camera {
         }
         let axes = [self.forward, self.up, self.right];
         let unit = axes.iter().all(|a| a.is_finite() && (a.length() - 1.0).abs() < 1e-3);
-        let orthogonal = self.forward.dot(self.up).abs() < 1e-3 && self.forward.dot(self.right).abs() < 1e-3 && self.up.dot(self.right).abs() < 1e-3;
+        let orthogonal =
+            self.forward.dot(self.up).abs() < 1e-3 && self.forward.dot(self.right).abs() < 1e-3 && self.up.dot(self.right).abs() < 1e-3;
         if !(unit && orthogonal) {
             anyhow::bail!("camera {name:?}: forward, up and right must be finite orthonormal axes (is up parallel to the view direction?)");
         }

@@ -24,8 +24,8 @@ pub struct DeviceSummary {
 /// Every Vulkan device, in the loader's order, through a short-lived instance without
 /// validation. Errors: no Vulkan loader or no instance (one line, as [`super::Context::new`]).
 pub fn list_devices() -> Result<Vec<DeviceSummary>> {
-    let entry = unsafe { ash::Entry::load() }
-        .map_err(|e| anyhow!("cannot load the Vulkan loader (libvulkan.so.1): {e}; run tools/setup.sh"))?;
+    let entry =
+        unsafe { ash::Entry::load() }.map_err(|e| anyhow!("cannot load the Vulkan loader (libvulkan.so.1): {e}; run tools/setup.sh"))?;
     let guard = create_instance(&entry, false, &Arc::<ValidationLog>::default())?;
     let instance = guard.instance();
     let devices = unsafe { instance.enumerate_physical_devices() }.context("enumerating Vulkan devices")?;
