@@ -12,6 +12,9 @@ CASES = [
      dict(method="pt", spp=8, width=32, height=24, seed=7)),
     (["--method", "pt", "--spp", "4", "--width", "32", "--height", "32", "--frames", "3", "--static-camera", "--russian-roulette", "off"],
      dict(method="pt", spp=4, width=32, height=32, frames=3, static_camera=True, russian_roulette=False)),
+    # Large enough that the path tracer splits its samples into dispatches by timing.
+    (["--method", "pt", "--spp", "64", "--width", "96", "--height", "64", "--seed", "2"],
+     dict(method="pt", spp=64, width=96, height=64, seed=2)),
     (["--width", "32", "--height", "32", "--seed", "3"],
      dict(method="restir", width=32, height=32, seed=3)),
     (["--width", "32", "--height", "32", "--frames", "4", "--seed", "5", "--shift", "reconnection", "--mis", "pairwise", "--reservoirs", "2", "--spatial", "2"],
@@ -21,7 +24,7 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("cli_args,kwargs", CASES, ids=["pt", "pt-static", "restir", "restir-moving", "restir-static"])
+@pytest.mark.parametrize("cli_args,kwargs", CASES, ids=["pt", "pt-static", "pt-chunked", "restir", "restir-moving", "restir-static"])
 def test_array_equals_cli_exr_bit_for_bit(tmp_path, device, cli_args, kwargs):
     out = tmp_path / "cli.exr"
     run_cli("render", CORNELL, *cli_args, "--out", out)
