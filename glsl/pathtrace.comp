@@ -32,8 +32,12 @@ void main() {
     // Lanes outside the image still reach the loop-budget report below, so no early return.
     bool inside = p.x < width && p.y < height;
     uint pixel = p.y * width + p.x;
-    vec3 sum = vec3(0.0);
-    vec3 sum_sq = vec3(0.0);
+    // The sums continue from the pixel's accumulated ones, one sample at a time, so that they
+    // add up in sample order whatever the split into dispatches (chunk sizes follow timing):
+    // equal seeds and settings give equal images, bit for bit.
+    vec4 accumulated = inside ? accum[pixel] : vec4(0.0);
+    vec3 sum = accumulated.rgb;
+    vec3 sum_sq = inside ? accum_sq[pixel].rgb : vec3(0.0);
     uint sample_index = 0u;
     uint nonfinite = 0u;
     PathState path = path_begin(p, path_seed(pixel, sample_offset, render_seed));
@@ -51,8 +55,8 @@ void main() {
     }
     note_loop_exit(inside && sample_index < samples_per_dispatch);
     if (inside) {
-        accum[pixel] += vec4(sum, float(samples_per_dispatch));
-        accum_sq[pixel].rgb += sum_sq;
+        accum[pixel] = vec4(sum, accumulated.w + float(samples_per_dispatch));
+        accum_sq[pixel].rgb = sum_sq;
     }
     uint iterations = subgroup_loop_iterations();
     bool cut = subgroup_loop_budget_cut();

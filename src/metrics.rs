@@ -1,4 +1,4 @@
-//! Image error metrics against a reference: relMSE (also trimmed), MSE, energy and
+//! Image error metrics against a reference: relMSE (also trimmed), MAPE, MSE, energy and
 //! frame-to-frame flicker.
 
 use glam::Vec3;
@@ -25,6 +25,24 @@ pub fn rel_squared_error(x: Vec3, r: Vec3) -> f64 {
 pub fn rel_mse(image: &[Vec3], reference: &[Vec3]) -> f64 {
     check_sizes(image, reference);
     let sum: f64 = image.iter().zip(reference).map(|(x, r)| rel_squared_error(*x, *r)).sum();
+    sum / (3 * image.len().max(1)) as f64
+}
+
+/// Guards MAPE's denominator where the reference is black: the same 1e-2 as relMSE's, in the
+/// reference's radiance units, so that a black reference pixel does not divide by zero and
+/// the two metrics treat dark pixels alike.
+pub const MAPE_EPSILON: f32 = 1e-2;
+
+/// Mean absolute percentage error as the ReSTIR papers report it (Lin et al. 2022, GRIS):
+/// the mean over pixels and channels of |x - r| / (r + [`MAPE_EPSILON`]), accumulated in f64;
+/// 0.1 reads as 10%. Unlike relMSE it weighs an error linearly, so a few fireflies count less.
+pub fn mape(image: &[Vec3], reference: &[Vec3]) -> f64 {
+    check_sizes(image, reference);
+    let sum: f64 = image
+        .iter()
+        .zip(reference)
+        .map(|(x, r)| ((*x - *r).abs() / (*r + Vec3::splat(MAPE_EPSILON))).element_sum() as f64)
+        .sum();
     sum / (3 * image.len().max(1)) as f64
 }
 
@@ -117,4 +135,22 @@ pub fn quantile(values: &[f64], q: f64) -> f64 {
     }
     let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
     v[rank - 1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mape_is_the_mean_absolute_error_over_reference_plus_epsilon() {
+        let reference = [Vec3::new(1.0, 0.5, 0.0), Vec3::splat(2.0)];
+        assert_eq!(mape(&reference, &reference), 0.0);
+        let image = [Vec3::new(1.1, 0.25, 0.02), Vec3::splat(3.0)];
+        // By hand: 0.1/1.01, 0.25/0.51, 0.02/0.01 and three times 1/2.01, over 6 channels.
+        let expected = (0.1 / 1.01 + 0.25 / 0.51 + 0.02 / 0.01 + 3.0 / 2.01) / 6.0;
+        assert!((mape(&image, &reference) - expected).abs() < 1e-6, "{}", mape(&image, &reference));
+        // Linear in the error: twice the error, twice the MAPE.
+        let doubled: Vec<Vec3> = image.iter().zip(&reference).map(|(x, r)| *r + 2.0 * (*x - *r)).collect();
+        assert!((mape(&doubled, &reference) - 2.0 * expected).abs() < 1e-5);
+    }
 }

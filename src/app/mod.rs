@@ -12,7 +12,7 @@ mod info;
 mod method_spec;
 mod profile;
 mod reference;
-mod reference_record;
+pub(crate) mod reference_record;
 mod render;
 mod render_loop;
 mod render_output;

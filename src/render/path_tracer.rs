@@ -154,6 +154,16 @@ impl PathTracer {
     /// the compiled kernel; the resolution must stay the same.
     pub fn restart(&mut self, settings: &RenderSettings) -> Result<()> {
         settings.validate(self.scene.info())?;
+        let camera = self.scene.info().cameras[settings.camera].clone();
+        self.restart_from(settings, &camera)
+    }
+
+    /// [`PathTracer::restart`] seen from `camera`, a pose in scene coordinates (as the scene's
+    /// cameras) that need not be one of the scene's; `settings.camera` is not used. Errors: as
+    /// `restart`, and a pose whose position or axes are not finite.
+    pub fn restart_from(&mut self, settings: &RenderSettings, camera: &crate::scene::Camera) -> Result<()> {
+        settings.validate_numbers()?;
+        camera.check_pose()?;
         if (settings.width, settings.height) != (self.settings.width, self.settings.height) {
             anyhow::bail!(
                 "restart cannot change the resolution ({}x{} to {}x{})",
@@ -165,7 +175,7 @@ impl PathTracer {
         }
         self.accum.fill(0)?;
         self.accum_sq.fill(0)?;
-        self.base_params = settings.frame_params(self.scene.info());
+        self.base_params = settings.frame_params_from(self.scene.info(), camera);
         self.settings = settings.clone();
         self.first_sample = 0;
         self.samples_done = 0;

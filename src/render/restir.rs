@@ -15,6 +15,7 @@ use super::reservoir_layers::ReservoirLayers;
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams};
+use crate::scene::Camera;
 use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
 use crate::vk::{compile_kernels_in_parallel, process_cpu_ms, Binding, Context, Kernel, KernelCompile, PassTimer};
@@ -277,13 +278,23 @@ impl Restir {
     /// `accumulate` the frame is added to the running average (a static camera's offline
     /// mode); otherwise the average restarts.
     pub fn frame(&mut self, camera: usize, accumulate: bool) -> Result<FrameStats> {
-        let start = Instant::now();
         let settings = RenderSettings {
             camera,
             ..self.settings.clone()
         };
         settings.validate(self.scene_gpu.info())?;
-        let frame_params = settings.frame_params(self.scene_gpu.info());
+        let camera = self.scene_gpu.info().cameras[camera].clone();
+        self.frame_from(&camera, accumulate)
+    }
+
+    /// [`Restir::frame`] seen from `camera`, a pose in scene coordinates (as the scene's
+    /// cameras) that need not be one of the scene's: a scripted camera path. A pose equal to
+    /// the last frame's counts as an unmoved camera. Errors: a pose whose position or axes are
+    /// not finite, or a failed submission.
+    pub fn frame_from(&mut self, camera: &Camera, accumulate: bool) -> Result<FrameStats> {
+        let start = Instant::now();
+        camera.check_pose()?;
+        let frame_params = self.settings.frame_params_from(self.scene_gpu.info(), camera);
         let plan = self.plan(&frame_params);
         let needed: Vec<PassKernel> = plan.passes.iter().map(|p| p.kernel).collect();
         self.build(&needed, &|_| {})?;

@@ -3,6 +3,7 @@
 use anyhow::{bail, Result};
 
 use crate::gpu_types::{FrameParams, FLAG_RUSSIAN_ROULETTE};
+use crate::scene::Camera;
 use crate::shading::path_record::MAX_PATH_LENGTH;
 
 use super::SceneInfo;
@@ -102,6 +103,13 @@ impl RenderSettings {
     /// The frame parameters for this render, before the per-dispatch sample range is set.
     /// `self.camera` must index `scene.cameras` (see `validate`).
     pub fn frame_params(&self, scene: &SceneInfo) -> FrameParams {
+        self.frame_params_from(scene, &scene.cameras[self.camera])
+    }
+
+    /// [`RenderSettings::frame_params`] seen from `camera` (scene coordinates, as
+    /// [`SceneInfo::cameras`]) instead of the scene's camera `self.camera`: a pose a caller
+    /// scripts frame by frame.
+    pub fn frame_params_from(&self, scene: &SceneInfo, camera: &Camera) -> FrameParams {
         let mut params = FrameParams {
             scene_env: scene.environment.extend(scene.env_select_prob).into(),
             width: self.width,
@@ -112,7 +120,7 @@ impl RenderSettings {
             emitter_count: scene.emitter_count,
             ..Default::default()
         };
-        scene.cameras[self.camera].fill_params(&mut params, self.width, self.height);
+        camera.fill_params(&mut params, self.width, self.height);
         params
     }
 }

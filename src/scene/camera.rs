@@ -86,6 +86,27 @@ impl Camera {
         }
     }
 
+    /// Whether the camera can render: a finite position, a finite orthonormal frame (within
+    /// 1e-3) and a vertical field of view in (0, π) radians. Errors: one line naming the camera
+    /// and the first problem, e.g. `look_at` with `up` parallel to the view direction.
+    pub fn check_pose(&self) -> anyhow::Result<()> {
+        let name = &self.name;
+        if !self.position.is_finite() {
+            anyhow::bail!("camera {name:?}: position {} is not finite", self.position);
+        }
+        let axes = [self.forward, self.up, self.right];
+        let unit = axes.iter().all(|a| a.is_finite() && (a.length() - 1.0).abs() < 1e-3);
+        let orthogonal =
+            self.forward.dot(self.up).abs() < 1e-3 && self.forward.dot(self.right).abs() < 1e-3 && self.up.dot(self.right).abs() < 1e-3;
+        if !(unit && orthogonal) {
+            anyhow::bail!("camera {name:?}: forward, up and right must be finite orthonormal axes (is up parallel to the view direction?)");
+        }
+        if !(self.yfov > 0.0 && self.yfov < std::f32::consts::PI) {
+            anyhow::bail!("camera {name:?}: yfov {} must be in (0, pi) radians", self.yfov);
+        }
+        Ok(())
+    }
+
     /// tan(vertical field of view / 2) for an image of `width` x `height`. The camera's view is
     /// fitted into the image: an image wider than the camera's `aspect_ratio` keeps yfov and shows
     /// more at the sides; a narrower one widens the vertical field of view until the camera's

@@ -119,7 +119,7 @@ pub struct Context {
     _entry: ash::Entry,
 }
 
-fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
+pub(super) fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
     props
         .device_name_as_c_str()
         .map(|s| s.to_string_lossy().into_owned())
@@ -310,7 +310,7 @@ impl Drop for Context {
 }
 
 /// Owns the instance (and messenger) while the device is being created.
-struct InstanceGuard {
+pub(super) struct InstanceGuard {
     instance: Option<ash::Instance>,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
 }
@@ -318,7 +318,7 @@ struct InstanceGuard {
 type DebugMessenger = Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>;
 
 impl InstanceGuard {
-    fn instance(&self) -> &ash::Instance {
+    pub(super) fn instance(&self) -> &ash::Instance {
         self.instance.as_ref().expect("instance is present until released")
     }
     fn release(mut self) -> (ash::Instance, DebugMessenger) {
@@ -341,7 +341,7 @@ impl Drop for InstanceGuard {
 
 /// The instance, with the validation layer and a messenger that reports into `log` when
 /// `validation` is set; owned by the returned guard.
-fn create_instance(entry: &ash::Entry, validation: bool, log: &Arc<ValidationLog>) -> Result<InstanceGuard> {
+pub(super) fn create_instance(entry: &ash::Entry, validation: bool, log: &Arc<ValidationLog>) -> Result<InstanceGuard> {
     let app_name = CString::new("restir-pt").expect("static name has no NUL");
     let app_info = vk::ApplicationInfo::default()
         .application_name(&app_name)

@@ -2,6 +2,7 @@
 
 mod buffer;
 mod context;
+mod device_list;
 mod kernel;
 mod reflect;
 mod shader;
@@ -10,6 +11,7 @@ mod timer;
 
 pub use buffer::{Buffer, BufferUsage};
 pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
+pub use device_list::{list_devices, DeviceSummary};
 pub use kernel::{record_compute_barrier, record_host_read_barrier, Binding, BindingSlot, BoundBuffer, Kernel, KernelCompile};
 pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};
 pub use shader::{
