@@ -94,7 +94,9 @@ def render(
 
     Keyword names are the CLI's options with underscores. ``method`` is ``"restir"`` (the
     CLI's default) or ``"pt"``; ``frames`` walk the scene's camera path from ``camera`` (or
-    stay at it with ``static_camera``, averaging: the path tracer then holds frames x spp);
+    stay at it with ``static_camera``, averaging: the path tracer then holds frames x spp;
+    one frame by default, the CLI's ``--frames 1``: without ``--frames`` the CLI renders
+    ReSTIR PT to a time budget instead, which a script sets with ``frames``);
     ``settings`` are ReSTIR PT's options (:data:`RESTIR_OPTIONS`). The array is the last
     frame's float32 (height, width, 3) image, bit for bit the EXR the CLI writes for the same
     arguments. With ``return_stats`` returns ``(image, stats)``, one dict per frame. Flags the

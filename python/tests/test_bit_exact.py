@@ -15,7 +15,7 @@ CASES = [
     # Large enough that the path tracer splits its samples into dispatches by timing.
     (["--method", "pt", "--spp", "64", "--width", "96", "--height", "64", "--seed", "2"],
      dict(method="pt", spp=64, width=96, height=64, seed=2)),
-    (["--width", "32", "--height", "32", "--seed", "3"],
+    (["--width", "32", "--height", "32", "--frames", "1", "--seed", "3"],
      dict(method="restir", width=32, height=32, seed=3)),
     (["--width", "32", "--height", "32", "--frames", "4", "--seed", "5", "--shift", "reconnection", "--mis", "pairwise", "--reservoirs", "2", "--spatial", "2"],
      dict(method="restir", width=32, height=32, frames=4, seed=5, shift="reconnection", mis="pairwise", reservoirs=2, spatial=2)),
