@@ -2,6 +2,7 @@
 
 mod buffer;
 mod context;
+mod device_setup;
 mod kernel;
 mod reflect;
 mod shader;
@@ -9,7 +10,7 @@ mod spirv_cache;
 mod timer;
 
 pub use buffer::{Buffer, BufferUsage};
-pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
+pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog, DEFAULT_FENCE_TIMEOUT};
 pub use kernel::{record_compute_barrier, record_host_read_barrier, Binding, BindingSlot, BoundBuffer, Kernel, KernelCompile};
 pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};
 pub use shader::{compile_kernel, compile_kernel_cached_in, glsl_source};

@@ -45,6 +45,7 @@ mod specular_layer;
 mod speed_accuracy;
 mod spirv_cache;
 mod statistics;
+mod stress;
 mod surface_oracle;
 mod sweeps;
 mod textured_scenes;
