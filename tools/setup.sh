@@ -41,4 +41,9 @@ else
 fi
 
 command -v cargo >/dev/null || { echo "tools/setup.sh: cargo not found; install Rust (rustup) first" >&2; exit 1; }
+# cargo-nextest runs the suite one process per test (README, .ci/run); built from crates.io
+# where missing (several minutes on 2 cores).
+if ! cargo nextest --version >/dev/null 2>&1; then
+  cargo install cargo-nextest --locked
+fi
 echo "tools/setup.sh: system packages present (${#packages[@]} checked, ${#missing[@]} installed)"

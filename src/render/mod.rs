@@ -13,7 +13,7 @@
 //!
 //! fn main() -> anyhow::Result<()> {
 //!     let scene = load_scene(std::path::Path::new("scenes/cornell.gltf"))?;
-//!     let options = ContextOptions { device: None, validation: false, scene_binding_limit: None };
+//!     let options = ContextOptions { device: None, validation: false, ..Default::default() };
 //!     let ctx = Arc::new(Context::new(&options)?);
 //!     let scene = SceneGpu::upload(&ctx, &scene)?;
 //!     let settings = RenderSettings::default();

@@ -225,6 +225,11 @@ impl Buffer {
 
 impl Drop for Buffer {
     fn drop(&mut self) {
+        if self.ctx.is_hung() {
+            // An unfinished submission may still read or write it (Context::is_hung).
+            std::mem::forget(self.allocation.take());
+            return;
+        }
         unsafe { self.ctx.device.destroy_buffer(self.handle, None) };
         if let Some(allocation) = self.allocation.take() {
             // Freeing only fails for foreign allocations, which this type never holds.

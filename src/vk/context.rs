@@ -1,21 +1,26 @@
 //! Vulkan instance, device and queue, the memory allocator and the validation messenger.
 //! Field order is drop order: the allocator goes before the device, the device before the instance.
 
-use std::ffi::{c_void, CStr, CString};
+use std::ffi::CStr;
 use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex};
 
-use anyhow::{anyhow, bail, Context as _, Result};
+use anyhow::{anyhow, bail, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
+use super::device_setup::{create_device, create_instance, pick_device, DebugMessenger};
 use crate::error::{vk_error, GpuError};
 
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+pub(super) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 /// llvmpipe's LP_MAX_TGSI_LOOP_ITERATIONS: each loop's budget per shader invocation.
-const LLVMPIPE_LOOP_LIMIT: u32 = 65535;
-/// One submission must never block the caller forever; a healthy chunk finishes in well under this.
-const FENCE_TIMEOUT_NS: u64 = 120_000_000_000;
+pub(super) const LLVMPIPE_LOOP_LIMIT: u32 = 65535;
+/// How long `submit_and_wait` waits for one submission by default. A submission's first dispatch
+/// of a kernel includes llvmpipe's JIT compile, which takes up to a minute for a
+/// scene-specialised ReSTIR kernel on an idle 2-core machine and several times that beside other
+/// jobs (a 120 s limit was overrun there); GPUs with a hang watchdog report a lost device long
+/// before this.
+pub const DEFAULT_FENCE_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(600);
 
 /// How [`Context::new`] picks and sets up the device.
 #[derive(Debug, Clone, Default)]
@@ -27,6 +32,9 @@ pub struct ContextOptions {
     /// Bytes past which a scene array is reached by buffer device address rather than bound (at most
     /// maxStorageBufferRange, the default). Tests lower it so that small scenes take the addressed path.
     pub scene_binding_limit: Option<u64>,
+    /// How long one submission may run before `submit_and_wait` gives up on it and the device
+    /// is considered hung (`None`: [`DEFAULT_FENCE_TIMEOUT`]).
+    pub fence_timeout: Option<std::time::Duration>,
 }
 
 /// What the chosen device is and the limits the renderers plan around.
@@ -63,7 +71,7 @@ pub struct DeviceInfo {
 /// context: leaks are reported while the device is destroyed.
 #[derive(Default)]
 pub struct ValidationLog {
-    errors: Mutex<Vec<String>>,
+    pub(super) errors: Mutex<Vec<String>>,
 }
 
 impl ValidationLog {
@@ -71,28 +79,6 @@ impl ValidationLog {
     pub fn messages(&self) -> Vec<String> {
         self.errors.lock().map(|e| e.clone()).unwrap_or_default()
     }
-}
-
-unsafe extern "system" fn debug_callback(
-    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    _types: vk::DebugUtilsMessageTypeFlagsEXT,
-    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
-    user: *mut c_void,
-) -> vk::Bool32 {
-    let message = if data.is_null() || (*data).p_message.is_null() {
-        "<no message>".to_string()
-    } else {
-        CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
-    };
-    let counts = severity.intersects(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING);
-    if counts && !user.is_null() {
-        eprintln!("vulkan validation: {message}");
-        let log = &*(user as *const ValidationLog);
-        if let Ok(mut errors) = log.errors.lock() {
-            errors.push(message);
-        }
-    }
-    vk::FALSE
 }
 
 /// One Vulkan device with its compute queue, memory allocator and (optionally) validation messenger:
@@ -110,30 +96,17 @@ pub struct Context {
     pub physical_device: vk::PhysicalDevice,
     /// The device's name and limits.
     pub info: DeviceInfo,
-    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    debug: DebugMessenger,
     validation_log: Arc<ValidationLog>,
     /// Compute pipelines created on this device (see `pipelines_created`).
     pipelines: std::sync::atomic::AtomicU64,
+    fence_timeout: std::time::Duration,
+    /// Set when a submission overran `fence_timeout`: the driver may still be executing it, so
+    /// nothing made on this device may be destroyed or reused (see `is_hung`).
+    hung: std::sync::atomic::AtomicBool,
     /// The raw instance handle.
     pub instance: ash::Instance,
     _entry: ash::Entry,
-}
-
-pub(super) fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
-    props
-        .device_name_as_c_str()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
-}
-
-fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-        vk::PhysicalDeviceType::CPU => 3,
-        _ => 4,
-    }
 }
 
 impl Context {
@@ -192,6 +165,8 @@ impl Context {
             debug,
             validation_log,
             pipelines: std::sync::atomic::AtomicU64::new(0),
+            fence_timeout: options.fence_timeout.unwrap_or(DEFAULT_FENCE_TIMEOUT),
+            hung: std::sync::atomic::AtomicBool::new(false),
             instance,
             _entry: entry,
         })
@@ -263,38 +238,87 @@ impl Context {
         Ok(())
     }
 
+    /// Whether a submission overran the fence timeout. The driver may still be executing it,
+    /// reading its command buffer, descriptor sets, pipelines and buffers; so from then on every
+    /// object made on this device (buffers, kernels, timers, the device itself) is leaked
+    /// rather than destroyed when dropped, and no further work is submitted. Destroying them
+    /// under a running submission crashed lavapipe (docs/testing.md, "Crashes").
+    pub fn is_hung(&self) -> bool {
+        self.hung.load(std::sync::atomic::Ordering::Acquire)
+    }
+
+    fn hung_error(&self) -> GpuError {
+        GpuError::Timeout {
+            seconds: self.fence_timeout.as_secs(),
+        }
+    }
+
     /// Records commands with `record`, submits them with a fence and waits for completion.
+    ///
+    /// # Errors
+    /// [`GpuError::Timeout`] when the submission does not finish within the fence timeout, or
+    /// when an earlier one did not (the device is then hung: see [`Context::is_hung`]); the
+    /// command buffer and fence of an unfinished submission are leaked, never freed under it.
+    /// [`GpuError::DeviceLost`] and other Vulkan errors as reported.
     pub fn submit_and_wait(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<(), GpuError> {
+        if self.is_hung() {
+            return Err(self.hung_error());
+        }
         let alloc_info = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.command_pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
         let cmd = unsafe { self.device.allocate_command_buffers(&alloc_info) }.map_err(vk_error("allocating a command buffer"))?[0];
-        let result = (|| {
-            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-            unsafe { self.device.begin_command_buffer(cmd, &begin) }.map_err(vk_error("beginning a command buffer"))?;
-            record(cmd);
-            unsafe { self.device.end_command_buffer(cmd) }.map_err(vk_error("ending a command buffer"))?;
-            let fence = unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) }.map_err(vk_error("creating a fence"))?;
-            let cmds = [cmd];
-            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-            let submitted = unsafe { self.device.queue_submit(self.queue, &submit, fence) }.map_err(vk_error("submitting GPU work"));
-            let waited = submitted.and_then(|_| match unsafe { self.device.wait_for_fences(&[fence], true, FENCE_TIMEOUT_NS) } {
-                Err(vk::Result::TIMEOUT) => Err(GpuError::Timeout {
-                    seconds: FENCE_TIMEOUT_NS / 1_000_000_000,
-                }),
-                other => other.map_err(vk_error("waiting for GPU work")),
-            });
-            unsafe { self.device.destroy_fence(fence, None) };
-            waited
-        })();
-        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
-        result
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let recorded = unsafe { self.device.begin_command_buffer(cmd, &begin) }
+            .map_err(vk_error("beginning a command buffer"))
+            .and_then(|_| {
+                record(cmd);
+                unsafe { self.device.end_command_buffer(cmd) }.map_err(vk_error("ending a command buffer"))
+            })
+            .and_then(|_| unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) }.map_err(vk_error("creating a fence")));
+        let fence = match recorded {
+            Ok(fence) => fence,
+            Err(e) => {
+                unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
+                return Err(e);
+            }
+        };
+        let cmds = [cmd];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        let timeout_ns = u64::try_from(self.fence_timeout.as_nanos()).unwrap_or(u64::MAX);
+        let waited = match unsafe { self.device.queue_submit(self.queue, &submit, fence) } {
+            Err(e) => Err(vk_error("submitting GPU work")(e)),
+            Ok(()) => unsafe { self.device.wait_for_fences(&[fence], true, timeout_ns) }.map_err(|e| match e {
+                vk::Result::TIMEOUT => {
+                    // The driver still owns the command buffer and everything it references:
+                    // the fence and the command buffer are leaked, and the device is marked
+                    // so that no owner of its objects destroys them.
+                    self.hung.store(true, std::sync::atomic::Ordering::Release);
+                    self.hung_error()
+                }
+                other => vk_error("waiting for GPU work")(other),
+            }),
+        };
+        if !self.is_hung() {
+            unsafe {
+                self.device.destroy_fence(fence, None);
+                self.device.free_command_buffers(self.command_pool, &[cmd]);
+            }
+        }
+        waited
     }
 }
 
 impl Drop for Context {
     fn drop(&mut self) {
+        if self.is_hung() {
+            // A submission may still run and may never end: waiting could hang, destroying
+            // would free what it reads. The device, its memory and the instance are leaked, and
+            // so is the validation log that the instance's messenger still points at.
+            std::mem::forget(self.validation_log.clone());
+            return;
+        }
         unsafe {
             // A lost device may refuse to idle; teardown proceeds regardless.
             let _ = self.device.device_wait_idle();
@@ -307,193 +331,4 @@ impl Drop for Context {
             self.instance.destroy_instance(None);
         }
     }
-}
-
-/// Owns the instance (and messenger) while the device is being created.
-pub(super) struct InstanceGuard {
-    instance: Option<ash::Instance>,
-    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-}
-
-type DebugMessenger = Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>;
-
-impl InstanceGuard {
-    pub(super) fn instance(&self) -> &ash::Instance {
-        self.instance.as_ref().expect("instance is present until released")
-    }
-    fn release(mut self) -> (ash::Instance, DebugMessenger) {
-        (self.instance.take().expect("released once"), self.debug.take())
-    }
-}
-
-impl Drop for InstanceGuard {
-    fn drop(&mut self) {
-        if let Some(instance) = self.instance.take() {
-            unsafe {
-                if let Some((loader, messenger)) = self.debug.take() {
-                    loader.destroy_debug_utils_messenger(messenger, None);
-                }
-                instance.destroy_instance(None);
-            }
-        }
-    }
-}
-
-/// The instance, with the validation layer and a messenger that reports into `log` when
-/// `validation` is set; owned by the returned guard.
-pub(super) fn create_instance(entry: &ash::Entry, validation: bool, log: &Arc<ValidationLog>) -> Result<InstanceGuard> {
-    let app_name = CString::new("restir-pt").expect("static name has no NUL");
-    let app_info = vk::ApplicationInfo::default()
-        .application_name(&app_name)
-        .engine_name(&app_name)
-        .api_version(vk::API_VERSION_1_2);
-    let layer_ptrs = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-    let ext_ptrs = if validation {
-        vec![ash::ext::debug_utils::NAME.as_ptr()]
-    } else {
-        vec![]
-    };
-    let log_ptr = &**log as *const ValidationLog as *mut c_void;
-    let messenger_info = || {
-        vk::DebugUtilsMessengerCreateInfoEXT::default()
-            .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
-            .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
-            .pfn_user_callback(Some(debug_callback))
-            .user_data(log_ptr)
-    };
-    let mut instance_messenger = messenger_info();
-    let mut instance_info = vk::InstanceCreateInfo::default()
-        .application_info(&app_info)
-        .enabled_layer_names(&layer_ptrs)
-        .enabled_extension_names(&ext_ptrs);
-    if validation {
-        // Chained so that messages from instance creation itself are caught too.
-        instance_info = instance_info.push_next(&mut instance_messenger);
-    }
-    let instance = unsafe { entry.create_instance(&instance_info, None) }
-        .map_err(|e| anyhow!("cannot create a Vulkan instance: {e:?} (is a Vulkan driver such as mesa-vulkan-drivers installed?)"))?;
-    let mut guard = InstanceGuard {
-        instance: Some(instance),
-        debug: None,
-    };
-    if validation {
-        let loader = ash::ext::debug_utils::Instance::new(entry, guard.instance());
-        let messenger =
-            unsafe { loader.create_debug_utils_messenger(&messenger_info(), None) }.map_err(vk_error("creating the debug messenger"))?;
-        guard.debug = Some((loader, messenger));
-    }
-    Ok(guard)
-}
-
-/// The logical device with one queue of `queue_family` (and buffer device addresses when
-/// `device_address`), that queue and a command pool on it.
-fn create_device(
-    instance: &ash::Instance,
-    physical_device: vk::PhysicalDevice,
-    queue_family: u32,
-    device_address: bool,
-) -> Result<(ash::Device, vk::Queue, vk::CommandPool)> {
-    let priorities = [1.0f32];
-    let queue_infos = [vk::DeviceQueueCreateInfo::default()
-        .queue_family_index(queue_family)
-        .queue_priorities(&priorities)];
-    let mut address_features = vk::PhysicalDeviceBufferDeviceAddressFeatures::default().buffer_device_address(true);
-    let mut device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
-    if device_address {
-        device_info = device_info.push_next(&mut address_features);
-    }
-    let device = unsafe { instance.create_device(physical_device, &device_info, None) }.map_err(vk_error("creating the logical device"))?;
-    let queue = unsafe { device.get_device_queue(queue_family, 0) };
-    let pool_info = vk::CommandPoolCreateInfo::default()
-        .queue_family_index(queue_family)
-        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-    match unsafe { device.create_command_pool(&pool_info, None) } {
-        Ok(pool) => Ok((device, queue, pool)),
-        Err(e) => {
-            unsafe { device.destroy_device(None) };
-            Err(vk_error("creating the command pool")(e).into())
-        }
-    }
-}
-
-/// Lists every device as "index: name (type)" for error messages and `--device` help.
-fn describe_devices(instance: &ash::Instance, devices: &[vk::PhysicalDevice]) -> String {
-    devices
-        .iter()
-        .enumerate()
-        .map(|(i, &d)| {
-            let props = unsafe { instance.get_physical_device_properties(d) };
-            format!("{i}: {} ({:?})", device_name(&props), props.device_type)
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
-    let devices = unsafe { instance.enumerate_physical_devices() }.context("enumerating Vulkan devices")?;
-    if devices.is_empty() {
-        bail!("no Vulkan device found; install mesa-vulkan-drivers (lavapipe) with tools/setup.sh");
-    }
-    let compute_family = |d: vk::PhysicalDevice| {
-        let families = unsafe { instance.get_physical_device_queue_family_properties(d) };
-        families
-            .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE))
-            .map(|i| (i as u32, families[i].timestamp_valid_bits))
-    };
-    let chosen = match wanted {
-        Some(w) => {
-            let by_index = w.parse::<usize>().ok().and_then(|i| devices.get(i).copied());
-            let by_name = || {
-                devices.iter().copied().find(|&d| {
-                    let props = unsafe { instance.get_physical_device_properties(d) };
-                    device_name(&props).to_lowercase().contains(&w.to_lowercase())
-                })
-            };
-            by_index.or_else(by_name).ok_or_else(|| {
-                anyhow!(
-                    "no Vulkan device matches --device {w:?}; available: {}",
-                    describe_devices(instance, &devices)
-                )
-            })?
-        }
-        None => devices
-            .iter()
-            .copied()
-            .filter(|&d| compute_family(d).is_some())
-            .min_by_key(|&d| type_rank(unsafe { instance.get_physical_device_properties(d) }.device_type))
-            .ok_or_else(|| {
-                anyhow!(
-                    "no Vulkan device has a compute queue; available: {}",
-                    describe_devices(instance, &devices)
-                )
-            })?,
-    };
-    let (family, timestamp_bits) = compute_family(chosen).ok_or_else(|| {
-        anyhow!(
-            "the chosen Vulkan device has no compute queue; available: {}",
-            describe_devices(instance, &devices)
-        )
-    })?;
-    let props = unsafe { instance.get_physical_device_properties(chosen) };
-    let mut address_features = vk::PhysicalDeviceBufferDeviceAddressFeatures::default();
-    let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut address_features);
-    unsafe { instance.get_physical_device_features2(chosen, &mut features) };
-    let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
-    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut maintenance3);
-    unsafe { instance.get_physical_device_properties2(chosen, &mut props2) };
-    let info = DeviceInfo {
-        name: device_name(&props),
-        device_type: props.device_type,
-        max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
-        max_uniform_buffer_range: props.limits.max_uniform_buffer_range as u64,
-        scene_binding_limit: props.limits.max_storage_buffer_range as u64,
-        buffer_device_address: address_features.buffer_device_address == vk::TRUE,
-        max_allocation_bytes: maintenance3.max_memory_allocation_size,
-        max_compute_shared_memory: props.limits.max_compute_shared_memory_size,
-        timestamp_period_ns: props.limits.timestamp_period,
-        timestamps_supported: timestamp_bits > 0 && props.limits.timestamp_compute_and_graphics == vk::TRUE,
-        loop_iteration_limit: device_name(&props).contains("llvmpipe").then_some(LLVMPIPE_LOOP_LIMIT),
-    };
-    Ok((chosen, family, info))
 }

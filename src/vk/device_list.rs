@@ -5,7 +5,7 @@ use std::sync::Arc;
 use anyhow::{anyhow, Context as _, Result};
 use ash::vk;
 
-use super::context::{create_instance, device_name};
+use super::device_setup::{create_instance, device_name};
 use super::ValidationLog;
 
 /// One physical device as the loader reports it.

@@ -382,6 +382,10 @@ pub fn record_host_read_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
 
 impl Drop for Kernel {
     fn drop(&mut self) {
+        if self.ctx.is_hung() {
+            // An unfinished submission may still use its pipeline and sets (Context::is_hung).
+            return;
+        }
         let device = &self.ctx.device;
         unsafe {
             device.destroy_pipeline(self.pipeline, None);

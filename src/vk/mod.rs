@@ -3,6 +3,7 @@
 mod buffer;
 mod context;
 mod device_list;
+mod device_setup;
 mod kernel;
 mod reflect;
 mod shader;
@@ -10,7 +11,7 @@ mod spirv_cache;
 mod timer;
 
 pub use buffer::{Buffer, BufferUsage};
-pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog};
+pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog, DEFAULT_FENCE_TIMEOUT};
 pub use device_list::{list_devices, DeviceSummary};
 pub use kernel::{record_compute_barrier, record_host_read_barrier, Binding, BindingSlot, BoundBuffer, Kernel, KernelCompile};
 pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};

@@ -71,6 +71,10 @@ impl PassTimer {
 
 impl Drop for PassTimer {
     fn drop(&mut self) {
+        if self.ctx.is_hung() {
+            // An unfinished submission may still write its timestamps (Context::is_hung).
+            return;
+        }
         unsafe { self.ctx.device.destroy_query_pool(self.pool, None) };
     }
 }

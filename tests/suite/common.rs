@@ -20,6 +20,7 @@ pub fn gpu_with_scene_binding_limit(limit: Option<u64>) -> Arc<Context> {
         device: None,
         validation: true,
         scene_binding_limit: limit,
+        ..Default::default()
     })
     .expect("a Vulkan device with validation layers (tools/setup.sh)");
     Arc::new(ctx)

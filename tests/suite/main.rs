@@ -49,6 +49,7 @@ mod speed_accuracy;
 mod spirv_cache;
 mod startup;
 mod statistics;
+mod stress;
 mod surface_oracle;
 mod sweeps;
 mod textured_scenes;
