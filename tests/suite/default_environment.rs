@@ -96,8 +96,8 @@ fn default_environment_lights_an_open_asset_with_its_own_emitters_unless_env_non
     }
 }
 
-/// `--env-rotation` and `--env none` through the CLI: a map bright only in its centre column
-/// (Mitsuba 3's +Z) seen by a camera looking along +X is dark unrotated, bright turned by 90
+/// `--env-rotation` and `--env none` through the CLI: a map bright only in its two centre columns
+/// (u in [7/16, 9/16), around Mitsuba 3's +Z) seen by a camera looking along +X is dark unrotated, bright turned by 90
 /// degrees (the column comes to +X) and dark at -90; `--env none` renders a lightless file black
 /// with a warning; a bad angle is one error line.
 #[test]
@@ -108,7 +108,13 @@ fn default_environment_cli_env_rotation_turns_the_map_and_env_none_turns_it_off(
     std::fs::create_dir_all(&dir).unwrap();
     let (w, h) = (16u32, 8u32);
     let texels: Vec<Vec3> = (0..w * h)
-        .map(|k| if k % w == 8 { Vec3::splat(10.0) } else { Vec3::splat(0.1) })
+        .map(|k| {
+            if k % w == 7 || k % w == 8 {
+                Vec3::splat(10.0)
+            } else {
+                Vec3::splat(0.1)
+            }
+        })
         .collect();
     let sky = dir.join("column.exr");
     restir_pt::image_io::write_exr(&sky, w, h, &texels).unwrap();
