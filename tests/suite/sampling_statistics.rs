@@ -282,10 +282,17 @@ fn environment_map_orientation_is_mitsubas_and_rotation_turns_it_about_up() {
     for uv in [Vec2::new(0.1, 0.3), Vec2::new(0.6, 0.8), Vec2::new(0.95, 0.5)] {
         assert!(close(equirect_uv(equirect_dir(uv)), uv), "{uv}");
     }
-    // One bright texel column at the centre (u = 0.5): it must light +Z unrotated, +X at 90.
+    // Two bright texel columns around the centre (u in [7/16, 9/16)): they must light +Z
+    // unrotated, +X at 90.
     let (w, h) = (16u32, 8u32);
     let texels: Vec<Vec3> = (0..w * h)
-        .map(|k| if k % w == 8 { Vec3::splat(10.0) } else { Vec3::splat(0.1) })
+        .map(|k| {
+            if k % w == 7 || k % w == 8 {
+                Vec3::splat(10.0)
+            } else {
+                Vec3::splat(0.1)
+            }
+        })
         .collect();
     let map = EnvironmentMap::new(w, h, texels).unwrap();
     assert_eq!(map.radiance(Vec3::new(0.01, 0.0, 1.0).normalize()), Vec3::splat(10.0));
