@@ -109,13 +109,14 @@ bool refract_dir(vec3 w, vec3 m, float eta, out vec3 wt, out float etap) {
 }
 
 // The split by metallic and transmission factors: the non-metal (diffuse base and its specular
-// layer), the conductor and the dielectric.
+// layer), the conductor and the dielectric. KHR_materials_transmission replaces only the
+// non-metal part (metals are not transmissive): mix(mix(base, dielectric, t), conductor, k).
 void lobe_weights(Material m, out float w_diffuse, out float w_conductor, out float w_dielectric) {
     float t = clamp(m.transmission, 0.0, 1.0);
     float k = clamp(m.metallic, 0.0, 1.0);
     w_diffuse = (1.0 - t) * (1.0 - k);
-    w_conductor = (1.0 - t) * k;
-    w_dielectric = t;
+    w_conductor = k;
+    w_dielectric = t * (1.0 - k);
 }
 
 float max_component3(vec3 v) { return max(v.x, max(v.y, v.z)); }

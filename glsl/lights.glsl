@@ -128,20 +128,32 @@ float emitter_pdf(uint tri_index, vec3 dir, float dist) {
     return p_area * dist * dist / cos_l;
 }
 
-// u = 0.5 + atan2(d.x, -d.z) / 2pi (the centre column looks along -Z), v = acos(d.y) / pi (top +Y).
-vec2 equirect_uv(vec3 d) { return vec2(0.5 + atan(d.x, -d.z) / (2.0 * PI), acos(clamp(d.y, -1.0, 1.0)) / PI); }
+// Mitsuba 3's mapping in the map's frame: u = atan2(d.x, -d.z) / 2pi wrapped to [0, 1) (the
+// centre column looks along +Z, the edges along -Z), v = acos(d.y) / pi (top +Y).
+vec2 equirect_uv(vec3 d) {
+    float u = atan(d.x, -d.z) / (2.0 * PI);
+    return vec2(u < 0.0 ? u + 1.0 : u, acos(clamp(d.y, -1.0, 1.0)) / PI);
+}
 
 vec3 equirect_dir(vec2 uv) {
-    float phi = (uv.x - 0.5) * 2.0 * PI;
+    float phi = uv.x * 2.0 * PI;
     float theta = uv.y * PI;
     float s = sin(theta);
     return vec3(s * sin(phi), cos(theta), -s * cos(phi));
 }
 
 #if SCENE_ENV_MAP
-// Header (width, 0, 0, height), one row-CDF value per row, then per texel (r, g, b, row CDF).
+// Header (width, cos, sin, height) of the rotation about +Y (--env-rotation), one row-CDF value
+// per row, then per texel (r, g, b, row CDF).
 Emitter env_row(uint k) { return emitters[emitter_count + SCENE_ENV_MAP_BASE + k]; }
 uvec2 env_size() { Emitter h = env_row(0u); return uvec2(h.triangle, h.alias); }
+vec2 env_rotation() { Emitter h = env_row(0u); return vec2(h.select_pdf, h.alias_prob); }
+
+// d turned about +Y by the angle of (cos, sin) cs. Twin: environment::env_rotate.
+vec3 env_rotate(vec3 d, vec2 cs) { return vec3(cs.x * d.x + cs.y * d.z, d.y, cs.x * d.z - cs.y * d.x); }
+
+// The map's (u, v) of scene direction d, the rotation undone.
+vec2 env_scene_uv(vec3 d) { vec2 cs = env_rotation(); return equirect_uv(env_rotate(d, vec2(cs.x, -cs.y))); }
 float env_cdf(uvec2 size, bool rows, uint i, uint j) {
     return rows ? uintBitsToFloat(env_row(1u + j).triangle) : uintBitsToFloat(env_row(1u + size.y + i * size.x + j).alias);
 }
@@ -175,7 +187,7 @@ float env_texel_probability(uvec2 size, uint i, uint j) {
 vec3 environment_radiance(vec3 dir) {
 #if SCENE_ENV_MAP
     uvec2 size = env_size();
-    uvec2 ij = env_texel_of(size, equirect_uv(dir));
+    uvec2 ij = env_texel_of(size, env_scene_uv(dir));
     Emitter t = env_row(1u + size.y + ij.x * size.x + ij.y);
     return vec3(uintBitsToFloat(t.triangle), t.select_pdf, t.alias_prob);
 #else
@@ -189,7 +201,7 @@ float environment_pdf(vec3 dir) {
     uvec2 size = env_size();
     float sin_theta = length(dir.xz);  // not sqrt(1 - y^2): y rounds to +-1 near the poles
     if (sin_theta <= 0.0) return 0.0;
-    uvec2 ij = env_texel_of(size, equirect_uv(dir));
+    uvec2 ij = env_texel_of(size, env_scene_uv(dir));
     float p_uv = env_texel_probability(size, ij.x, ij.y) * float(size.x * size.y);
     return env_select_prob() * p_uv / (2.0 * PI * PI * sin_theta);
 #else
@@ -208,7 +220,7 @@ vec3 sample_environment(vec2 u) {
     uint j = cdf_search(size, false, i, size.x, u.y);
     float left = j > 0u ? env_cdf(size, false, i, j - 1u) : 0.0;
     float fv = clamp((u.y - left) / max(env_cdf(size, false, i, j) - left, 1.17549435e-38), 0.0, 0.9999999);
-    return equirect_dir(vec2((float(j) + fv) / float(size.x), (float(i) + fu) / float(size.y)));
+    return env_rotate(equirect_dir(vec2((float(j) + fv) / float(size.x), (float(i) + fu) / float(size.y))), env_rotation());
 #else
     return sample_uniform_sphere(u);
 #endif

@@ -32,7 +32,7 @@ void hit_shading(uint triangle, vec2 bary, vec3 ng, out Material m, out vec3 ns)
 #if SCENE_SHADING_NORMALS
     uint material = triangles[triangle].material;
     SurfaceHit s = surface_at(triangle, bary);
-    m = textured_material(materials[material], material, s);
+    m = vertex_colored(textured_material(materials[material], material, s), s);
     ns = normal_mapped(material, s);
 #else
     m = material_at(triangle, bary);

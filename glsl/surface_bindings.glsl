@@ -24,7 +24,7 @@
 
 // One triangle's vertex attributes, in the triangles' order (scene space).
 struct TriangleSurface {
-    vec4 normal[3];     // xyz: vertex normal (zero: none, the face normal is used)
+    vec4 normal[3];     // xyz: vertex normal (zero: none, the face normal is used); w: COLOR_0 bits
     vec4 tangent[3];    // xyz: vertex tangent, w: handedness (bitangent = w * cross(n, t))
     vec4 uv[3];         // xy: TEXCOORD_0, zw: TEXCOORD_1
 };

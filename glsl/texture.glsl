@@ -51,6 +51,49 @@ vec2 texture_coordinates(TextureSlot slot, SurfaceHit s) {
     vec3 uv = vec3(slot.texcoord == 1u ? s.uv1 : s.uv0, 1.0);
     return vec2(dot(slot.u_row, uv), dot(slot.v_row, uv));
 }
+
+// The tangent frame of the coordinates slot looks its texture up with: KHR_texture_transform's
+// linear part A turns the frame with the lookup, tangent = normalize((A11 t + A10 b) / det A),
+// handedness flipped where det A < 0 (MikkTSpace's frame of the transform baked in). Twin:
+// texture::texture_tangent_frame.
+void texture_tangent_frame(TextureSlot slot, SurfaceHit s, out vec3 tangent, out float handedness) {
+    float a00 = slot.u_row.x, a01 = slot.u_row.y, a10 = slot.v_row.x, a11 = slot.v_row.y;
+    float det = a00 * a11 - a01 * a10;
+    tangent = s.tangent;
+    handedness = s.handedness;
+    if (det == 0.0 || isinf(det) || isnan(det)) return;
+    float sign_det = det < 0.0 ? -1.0 : 1.0;
+    if (a10 == 0.0) {
+        tangent = a11 * sign_det < 0.0 ? -s.tangent : s.tangent;
+        handedness = s.handedness * sign_det;
+        return;
+    }
+    vec3 b = s.handedness * cross(s.normal, s.tangent);
+    vec3 t = (s.tangent * a11 + b * a10) * sign_det;
+    if (dot(t, t) > 1e-12) {
+        tangent = normalize(t);
+        handedness = s.handedness * sign_det;
+    }
+}
+#endif
+
+#if SCENE_TEXTURES
+// The opacity of material `material` at s: baseColorFactor's alpha times the base colour
+// texture's (linear) alpha.
+float material_alpha(uint material, SurfaceHit s) {
+    TextureSlot slot = material_textures[material].base_color;
+    float a = material_textures[material].base_alpha;
+    if (slot.texture_index == NO_TEXTURE) return a;
+    return a * texture_lookup(slot.texture_index, texture_coordinates(slot, s), true).a;
+}
+
+// The share of an alpha-tested emitter's emission at s: 0 below the cutoff traversal uses, else
+// 1, or alpha for a BLEND emitter. Twin: texture::emission_coverage.
+float emission_coverage(Material m, uint material, SurfaceHit s) {
+    float a = material_alpha(material, s);
+    if (!(a >= material_textures[material].alpha_cutoff)) return 0.0;
+    return (m.flags & MATERIAL_BLEND_EMISSION) != 0u ? a : 1.0;
+}
 #endif
 
 // Material `m` (index `material`) with its textures applied at surface s.
@@ -68,6 +111,7 @@ Material textured_material(Material m, uint material, SurfaceHit s) {
     if (t.emissive.texture_index != NO_TEXTURE) {
         m.emission *= texture_lookup(t.emissive.texture_index, texture_coordinates(t.emissive, s), true).rgb;
     }
+    if ((m.flags & MATERIAL_ALPHA_EMISSION) != 0u) m.emission *= emission_coverage(m, material, s);
 #endif
     return m;
 }
@@ -80,30 +124,33 @@ vec3 normal_mapped(uint material, SurfaceHit s) {
     if (t.normal.texture_index == NO_TEXTURE) return s.normal;
     vec3 c = texture_lookup(t.normal.texture_index, texture_coordinates(t.normal, s), false).rgb;
     vec3 local = (c * 2.0 - 1.0) * vec3(t.normal_scale, t.normal_scale, 1.0);
-    vec3 n = s.tangent * local.x + (s.handedness * cross(s.normal, s.tangent)) * local.y + s.normal * local.z;
+    vec3 tangent;
+    float handedness;
+    texture_tangent_frame(t.normal, s, tangent, handedness);
+    vec3 n = tangent * local.x + (handedness * cross(s.normal, tangent)) * local.y + s.normal * local.z;
     return dot(n, n) > 1e-12 ? normalize(n) : s.normal;
 #else
     return s.normal;
 #endif
 }
 
-#if SCENE_TEXTURES
-// The opacity of material `material` at s: baseColorFactor's alpha times the base colour
-// texture's (linear) alpha.
-float material_alpha(uint material, SurfaceHit s) {
-    TextureSlot slot = material_textures[material].base_color;
-    float a = material_textures[material].base_alpha;
-    if (slot.texture_index == NO_TEXTURE) return a;
-    return a * texture_lookup(slot.texture_index, texture_coordinates(slot, s), true).a;
-}
-#endif
 
-// The material of triangle index `triangle` at barycentrics bary, textures applied.
+// m with the vertex colour of s applied: COLOR_0 multiplies the base colour, and the emission of
+// an unlit material (its base colour). Twin: texture::vertex_colored.
+Material vertex_colored(Material m, SurfaceHit s) {
+    m.base_color *= s.color;
+    if ((m.flags & MATERIAL_UNLIT) != 0u) m.emission *= s.color;
+    return m;
+}
+
+// The material of triangle index `triangle` at barycentrics bary, textures and vertex colour
+// applied. Twin: Scene::material_at.
 Material material_at(uint triangle, vec2 bary) {
     uint material = triangles[triangle].material;
     Material m = materials[material];
-#if SCENE_TEXTURES
-    m = textured_material(m, material, surface_at(triangle, bary));
+#if SCENE_SURFACE
+    SurfaceHit s = surface_at(triangle, bary);
+    m = vertex_colored(textured_material(m, material, s), s);
 #endif
     return m;
 }

@@ -17,6 +17,9 @@ struct Material {
     uint pad;
 };
 const uint MATERIAL_DOUBLE_SIDED = 1u;
+const uint MATERIAL_UNLIT = 2u;     // KHR_materials_unlit: COLOR_0 multiplies the emission
+const uint MATERIAL_ALPHA_EMISSION = 4u;    // emission times coverage (texture::emission_coverage)
+const uint MATERIAL_BLEND_EMISSION = 8u;    // ... the coverage being alpha (a BLEND emitter)
 
 // Vertex 0 and two edges, so that intersection needs no subtraction.
 struct Triangle {

@@ -7,6 +7,18 @@ use bytemuck::{Pod, Zeroable};
 /// [`Material::flags`] bit: both faces scatter and emit (glTF `doubleSided`); otherwise only the
 /// front face (counter-clockwise winding) emits.
 pub const MATERIAL_DOUBLE_SIDED: u32 = 1;
+/// [`Material::flags`] bit: a `KHR_materials_unlit` material, drawn as emission of its base
+/// colour, so that COLOR_0 multiplies its emission (`texture::vertex_colored`).
+pub const MATERIAL_UNLIT: u32 = 2;
+/// [`Material::flags`] bit: an emitter with an alpha mode, whose emission is multiplied by its
+/// coverage at the point (`texture::textured_material`): 0 where alpha < alphaCutoff (the
+/// surface is not there for traversal either), else 1, or alpha with
+/// [`MATERIAL_BLEND_EMISSION`]. Every estimator reads emission through it, so a light sample
+/// on a hole adds nothing and a label's letters glow while its background stays transparent.
+pub const MATERIAL_ALPHA_EMISSION: u32 = 4;
+/// [`Material::flags`] bit beside [`MATERIAL_ALPHA_EMISSION`]: a BLEND emitter, traversed where
+/// alpha > 0 and emitting alpha × emission (over-blending's weight of its own colour).
+pub const MATERIAL_BLEND_EMISSION: u32 = 8;
 /// [`Triangle::emitter`] of a triangle that emits nothing.
 pub const NO_EMITTER: u32 = u32::MAX;
 
@@ -26,13 +38,14 @@ pub struct Material {
     /// Perceptual (linear) roughness in [0, 1]; the GGX alpha is its square
     /// ([`crate::shading::bsdf::ggx_alpha`]).
     pub roughness: f32,
-    /// `KHR_materials_transmission` transmissionFactor in [0, 1]: the weight t of the dielectric
-    /// interface lobe; the non-metal and conductor lobes share 1 - t (`bsdf::lobe_weights`).
+    /// `KHR_materials_transmission` transmissionFactor in [0, 1]: the dielectric interface lobe
+    /// replaces that share of the non-metal part only (weights `bsdf::lobe_weights`).
     pub transmission: f32,
     /// Index of refraction of the inside (`KHR_materials_ior`, glTF default 1.5); also sets the
     /// specular layer's F0 = ((ior - 1) / (ior + 1))² · specular_color.
     pub ior: f32,
-    /// Bit set: [`MATERIAL_DOUBLE_SIDED`].
+    /// Bit set: [`MATERIAL_DOUBLE_SIDED`], [`MATERIAL_UNLIT`], [`MATERIAL_ALPHA_EMISSION`],
+    /// [`MATERIAL_BLEND_EMISSION`].
     pub flags: u32,
     /// `KHR_materials_specular` specularFactor: the strength of the non-metal specular layer
     /// (docs/materials.md); 0 makes the non-metal part purely Lambertian.

@@ -1,6 +1,7 @@
 #version 460
-// Oracle kernel: surface_at, triangle_bary, texture_lookup, texture_coordinates,
-// textured_material, normal_mapped, shading_normal and hit_shading on a scene with attributes
+// Oracle kernel: surface_at (with vertex_color), triangle_bary, texture_lookup,
+// texture_coordinates, texture_tangent_frame, textured_material, normal_mapped, shading_normal and
+// hit_shading on a scene with attributes
 // and textures (twins: src/surface.rs, src/texture.rs, src/scene/hit_surface.rs). Everything is bound in set 0: the scene at 0-4,
 // the surface bindings at 5-8, then inputs and outputs.
 #extension GL_GOOGLE_include_directive : require
@@ -16,7 +17,7 @@ layout(std430, set = 0, binding = 9) readonly buffer Inputs { vec4 inputs[]; };
 layout(std430, set = 0, binding = 10) writeonly buffer Outputs { vec4 outputs[]; };
 layout(push_constant) uniform Push { uint count; };
 
-const uint OUT_ROWS = 10u;
+const uint OUT_ROWS = 12u;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -42,4 +43,9 @@ void main() {
     hit_shading(tri, a.yz, normalize(cross(triangles[tri].e1, triangles[tri].e2)), hm, ns);
     outputs[o + 8u] = vec4(shading_normal(tri, a.yz), hm.roughness);
     outputs[o + 9u] = vec4(ns, hm.metallic);
+    vec3 frame_tangent;
+    float frame_handedness;
+    texture_tangent_frame(material_textures[material].normal, s, frame_tangent, frame_handedness);
+    outputs[o + 10u] = vec4(frame_tangent, frame_handedness);
+    outputs[o + 11u] = vec4(s.color, 0.0);
 }

@@ -162,10 +162,24 @@ pub struct SceneArgs {
     /// The glTF scene to use (index into the file's scenes; default: its default scene).
     #[arg(long = "scene")]
     pub scene_index: Option<usize>,
-    /// Environment replacing the scene's (and the default one): a radiance R,G,B, or an
-    /// equirectangular FILE.exr or FILE.hdr importance-sampled by luminance.
-    #[arg(long, value_parser = parse_env, value_name = "R,G,B|FILE", allow_hyphen_values = true)]
+    /// Environment replacing the scene's (and the default one): a radiance R,G,B, an
+    /// equirectangular FILE.exr or FILE.hdr importance-sampled by luminance (Mitsuba 3's
+    /// orientation: the centre column faces +Z), or `none` (the file's lights alone, no default
+    /// environment).
+    #[arg(long, value_parser = parse_env, value_name = "R,G,B|FILE|none", allow_hyphen_values = true)]
     pub env: Option<EnvArg>,
+    /// Turns the environment map about the up axis (+Y) by DEGREES (right-handed: 90 brings the
+    /// map's centre column from +Z to +X).
+    #[arg(long, value_parser = parse_degrees, value_name = "DEGREES", allow_hyphen_values = true, default_value_t = 0.0)]
+    pub env_rotation: f32,
+}
+
+/// `--env-rotation`: a finite angle in degrees.
+pub fn parse_degrees(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(d) if d.is_finite() => Ok(d),
+        _ => Err(format!("{s:?} is not a finite angle in degrees")),
+    }
 }
 
 impl SceneArgs {
@@ -182,6 +196,8 @@ impl SceneArgs {
             scene: self.scene_index,
             environment: self.env.as_ref().and_then(EnvArg::constant),
             environment_map: self.env.as_ref().and_then(EnvArg::file),
+            env_rotation: self.env_rotation,
+            no_environment: self.env == Some(EnvArg::None),
             array_limit,
         }
     }
@@ -271,27 +287,32 @@ pub fn parse_exposure(s: &str) -> Result<Exposure, String> {
 pub enum EnvArg {
     Constant(Vec3),
     File(PathBuf),
+    /// `--env none`: no environment, not even the default one.
+    None,
 }
 
 impl EnvArg {
     pub fn constant(&self) -> Option<Vec3> {
         match self {
             EnvArg::Constant(c) => Some(*c),
-            EnvArg::File(_) => None,
+            EnvArg::File(_) | EnvArg::None => None,
         }
     }
 
     pub fn file(&self) -> Option<PathBuf> {
         match self {
             EnvArg::File(f) => Some(f.clone()),
-            EnvArg::Constant(_) => None,
+            EnvArg::Constant(_) | EnvArg::None => None,
         }
     }
 }
 
-/// `--env`: FILE.exr or FILE.hdr (by extension, any case), else R,G,B radiances.
+/// `--env`: `none`, FILE.exr or FILE.hdr (by extension, any case), else R,G,B radiances.
 pub fn parse_env(s: &str) -> Result<EnvArg, String> {
     let lower = s.to_ascii_lowercase();
+    if lower.trim() == "none" {
+        return Ok(EnvArg::None);
+    }
     if lower.ends_with(".exr") || lower.ends_with(".hdr") {
         return Ok(EnvArg::File(PathBuf::from(s)));
     }
@@ -301,7 +322,7 @@ pub fn parse_env(s: &str) -> Result<EnvArg, String> {
 /// R,G,B radiances; each error names the value and its first problem (negative values included:
 /// the option takes hyphen values so that `--env -1,0,0` reaches this check, not clap's).
 fn parse_radiance(s: &str) -> Result<Vec3, String> {
-    const USAGE: &str = "--env takes R,G,B (three finite, non-negative radiances) or FILE.exr|FILE.hdr";
+    const USAGE: &str = "--env takes R,G,B (three finite, non-negative radiances), FILE.exr|FILE.hdr or none";
     if s.trim().is_empty() {
         return Err(format!("the value is empty; {USAGE}"));
     }
@@ -337,6 +358,9 @@ mod tests {
     fn env_parses_radiance_and_files_and_refuses_negative_radiance() {
         assert_eq!(parse_env("1, 0.5,0"), Ok(EnvArg::Constant(Vec3::new(1.0, 0.5, 0.0))));
         assert_eq!(parse_env("sky.HDR"), Ok(EnvArg::File("sky.HDR".into())));
+        assert_eq!(parse_env("none"), Ok(EnvArg::None));
+        assert_eq!(parse_degrees("-90"), Ok(-90.0));
+        assert!(parse_degrees("inf").is_err() && parse_degrees("east").is_err());
         for bad in ["-1,0,0", "1,2", "1,2,inf", "x,y,z"] {
             assert!(parse_env(bad).is_err(), "{bad}");
         }

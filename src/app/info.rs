@@ -11,7 +11,7 @@ use restir_pt::render::{PathTracer, RenderSettings, Restir, SceneGpu};
 use restir_pt::scene::Scene;
 use restir_pt::vk::KernelCompile;
 
-/// Materials listed one per line; vertex colours can make thousands of variants.
+/// Materials listed one per line; a file can hold thousands.
 const MAX_LISTED_MATERIALS: usize = 64;
 
 /// `restir-pt info`.

@@ -3,9 +3,15 @@
 //! angle), then a direction uniformly in its (u, v) rectangle (pbrt-v4's piecewise-constant 2D
 //! distribution, "Sampling Light Sources"). Twin of the environment half of glsl/lights.glsl.
 //!
-//! Mapping: u = 0.5 + atan2(d.x, -d.z) / 2π across the image (its centre column looks along -Z,
-//! glTF's forward), v = acos(d.y) / π down it (the top row is +Y). The radiance of a direction is
-//! its texel's (no filtering), so the pdf and the radiance are constant per texel together.
+//! Mapping (Mitsuba 3's `envmap` with an identity `to_world`): in the map's own frame
+//! u = atan2(d.x, -d.z) / 2π wrapped to [0, 1) across the image, so its left and right edges look
+//! along -Z (glTF's forward), u = 1/4 along +X and the centre column along +Z; v = acos(d.y) / π
+//! down it (the top row is +Y). Mitsuba 3 is the renderer this project checks its images against
+//! (docs/independent-check.md), so an HDRI lights a scene from the same side in both. The map's
+//! frame is the scene's turned by `rotation` about +Y (`--env-rotation`, right-handed: 90° turns
+//! the map's +Z towards the scene's +X), as Mitsuba's `to_world = rotate([0, 1, 0], angle)`. The
+//! radiance of a direction is its texel's (no filtering), so the pdf and the radiance are
+//! constant per texel together; the rotation keeps solid angles, so it changes neither.
 
 use std::f32::consts::PI;
 use std::path::Path;
@@ -30,19 +36,30 @@ pub struct EnvironmentMap {
     /// Conditional CDF within each row: `texel_cdf[i * width + j]` is the probability of texels
     /// 0..=j given row i.
     pub texel_cdf: Vec<f32>,
+    /// (cos, sin) of the map's rotation about +Y, the map's frame to the scene's
+    /// ([`Self::with_rotation`]; (1, 0) unrotated).
+    pub rotation: Vec2,
 }
 
-/// The (u, v) of direction `d` (unit) in [0, 1]². Twin of GLSL `equirect_uv`.
+/// The (u, v) in [0, 1]² of direction `d` (unit, the map's own frame). Twin of GLSL `equirect_uv`.
 pub fn equirect_uv(d: Vec3) -> Vec2 {
-    Vec2::new(0.5 + d.x.atan2(-d.z) / (2.0 * PI), d.y.clamp(-1.0, 1.0).acos() / PI)
+    let u = d.x.atan2(-d.z) / (2.0 * PI);
+    Vec2::new(if u < 0.0 { u + 1.0 } else { u }, d.y.clamp(-1.0, 1.0).acos() / PI)
 }
 
-/// The unit direction of (u, v). Twin of GLSL `equirect_dir`.
+/// The unit direction (the map's own frame) of (u, v). Twin of GLSL `equirect_dir`.
 pub fn equirect_dir(uv: Vec2) -> Vec3 {
-    let phi = (uv.x - 0.5) * 2.0 * PI;
+    let phi = uv.x * 2.0 * PI;
     let theta = uv.y * PI;
     let s = theta.sin();
     Vec3::new(s * phi.sin(), theta.cos(), -s * phi.cos())
+}
+
+/// Direction `d` turned about +Y by the angle whose cosine and sine are `cs`: the map's frame to
+/// the scene's with (cos, sin) of the rotation, the scene's to the map's with (cos, -sin).
+/// Twin of GLSL `env_rotate`.
+pub fn env_rotate(d: Vec3, cs: Vec2) -> Vec3 {
+    Vec3::new(cs.x * d.x + cs.y * d.z, d.y, cs.x * d.z - cs.y * d.x)
 }
 
 /// The first index whose CDF value exceeds `u` (the last if none).
@@ -107,7 +124,21 @@ impl EnvironmentMap {
             texels,
             row_cdf,
             texel_cdf,
+            rotation: Vec2::X,
         })
+    }
+
+    /// The map turned by `degrees` about +Y (right-handed: 90 turns the map's +Z, its centre
+    /// column, towards the scene's +X).
+    pub fn with_rotation(mut self, degrees: f32) -> Self {
+        let r = degrees.to_radians();
+        self.rotation = Vec2::new(r.cos(), r.sin());
+        self
+    }
+
+    /// The (u, v) of scene direction `d` (unit) on this map, its rotation undone.
+    fn scene_uv(&self, d: Vec3) -> Vec2 {
+        equirect_uv(env_rotate(d, Vec2::new(self.rotation.x, -self.rotation.y)))
     }
 
     /// Reads an OpenEXR (`.exr`) or Radiance (`.hdr`) file of linear RGB radiance.
@@ -150,14 +181,14 @@ impl EnvironmentMap {
     /// The radiance arriving from direction `d` (unit): the map's part of
     /// `lights::environment_radiance`, the twin of GLSL `environment_radiance`.
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        let (i, j) = self.env_texel_of(equirect_uv(d));
+        let (i, j) = self.env_texel_of(self.scene_uv(d));
         self.texels[i * self.width as usize + j]
     }
 
     /// The solid-angle density of [`Self::sample_environment`] at direction `d` (unit): the texel's
     /// probability times its (u, v) area's inverse, over the map's Jacobian 2π² sin θ.
     pub fn pdf(&self, d: Vec3) -> f32 {
-        let uv = equirect_uv(d);
+        let uv = self.scene_uv(d);
         // From x and z, not 1 - y²: near the poles y rounds to ±1 while x and z keep sin θ.
         let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
         if sin_theta <= 0.0 {
@@ -179,16 +210,18 @@ impl EnvironmentMap {
         let j = cdf_search(row, u.y);
         let left = if j > 0 { row[j - 1] } else { 0.0 };
         let fv = ((u.y - left) / (row[j] - left).max(f32::MIN_POSITIVE)).clamp(0.0, 0.999_999_9);
-        equirect_dir(Vec2::new((j as f32 + fv) / w as f32, (i as f32 + fu) / h as f32))
+        let local = equirect_dir(Vec2::new((j as f32 + fv) / w as f32, (i as f32 + fu) / h as f32));
+        env_rotate(local, self.rotation)
     }
 
     /// The rows after the punctual lights in the emitter buffer (glsl/types.glsl): a header
-    /// (width, 0, 0, height), the row CDF (one per row), then per texel (r, g, b, row CDF value).
+    /// (width, cos, sin, height) with the rotation's cosine and sine, the row CDF (one per row),
+    /// then per texel (r, g, b, row CDF value).
     pub fn gpu_rows(&self) -> Vec<Emitter> {
         let header = Emitter {
             triangle: self.width,
-            select_pdf: 0.0,
-            alias_prob: 0.0,
+            select_pdf: self.rotation.x,
+            alias_prob: self.rotation.y,
             alias: self.height,
         };
         let rows = self.row_cdf.iter().map(|&c| Emitter {

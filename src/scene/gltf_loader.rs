@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use glam::{DMat4, DVec3, Vec3};
 
+use super::default_environment::{light_open_scene, unlit_scene_line};
 pub use super::gltf_budget::ArrayLimit;
 use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
@@ -41,8 +42,6 @@ pub(super) struct Loader<'a> {
     pub(super) unlit: Vec<bool>,
     /// Index of the glTF default material in `materials`, added on first use.
     pub(super) default_material: Option<u32>,
-    /// Materials multiplied by a COLOR_0 colour: (material, colour bits) to the variant's index.
-    pub(super) colour_variants: HashMap<(u32, [u32; 3]), u32>,
     pub(super) cameras: Vec<Camera>,
     /// Punctual lights; their positions are set relative to `origin` once the walk is done.
     pub(super) lights: Vec<PunctualLight>,
@@ -62,7 +61,8 @@ pub(super) struct MeshCounts {
     pub degenerate: usize,
     pub degenerate_emitters: usize,
     pub points_or_lines: usize,
-    pub colour_varying: usize,
+    /// Some primitive has COLOR_0 (kept per vertex in the surface attributes).
+    pub vertex_colours: bool,
     /// Some vertex normal differs from its face's normal.
     pub smooth: bool,
     pub instances: usize,
@@ -79,10 +79,16 @@ pub(super) fn problem(path: &Path, msg: impl std::fmt::Display) -> anyhow::Error
 pub struct LoadOptions {
     /// The glTF scene to load (index into `scenes`); none: the file's default scene, else the first.
     pub scene: Option<usize>,
-    /// An environment that replaces the file's (and the default one).
+    /// An environment that replaces the file's and the default one (black included).
     pub environment: Option<Vec3>,
     /// An equirectangular environment map (.exr or .hdr) that replaces the file's environment.
     pub environment_map: Option<PathBuf>,
+    /// The map's rotation about +Y in degrees (`--env-rotation`; see
+    /// [`crate::scene::environment`] for the convention).
+    pub env_rotation: f32,
+    /// No environment at all (`--env none`): neither the file's nor the default one
+    /// (crate::scene::default_environment).
+    pub no_environment: bool,
     /// The most bytes the device lets one scene array take: a file whose accessor counts
     /// promise more triangles than that fails before its vertices are read.
     pub array_limit: Option<ArrayLimit>,
@@ -107,17 +113,30 @@ pub fn load_scene_reporting(path: &Path, options: &LoadOptions, warnings: &mut V
 /// Loads glTF or GLB bytes; external buffers resolve against `base` (none: only embedded data).
 /// `path` names the input in messages.
 pub fn load_scene_from_bytes(bytes: &[u8], base: Option<&Path>, path: &Path) -> Result<Scene> {
-    let mut warnings = Vec::new();
-    let parts = load_parts(Cow::Borrowed(bytes), base, path, &LoadOptions::default(), &mut warnings)?;
-    build_scene(parts, &warnings)
+    load_scene_from_bytes_with_options(bytes, base, path, &LoadOptions::default())
 }
 
-/// The scene's parts and the world position of its origin (`Scene::origin`).
-type LoadedParts = (SceneParts, DVec3);
+/// [`load_scene_from_bytes`] with `options`; warnings are in `Scene::warnings`.
+pub fn load_scene_from_bytes_with_options(bytes: &[u8], base: Option<&Path>, path: &Path, options: &LoadOptions) -> Result<Scene> {
+    let mut warnings = Vec::new();
+    let parts = load_parts(Cow::Borrowed(bytes), base, path, options, &mut warnings)?;
+    build_scene(parts, &mut warnings)
+}
 
-fn build_scene((parts, origin): LoadedParts, warnings: &[String]) -> Result<Scene> {
+/// The scene's parts, the world position of its origin (`Scene::origin`) and whether the
+/// default environment is still to be decided from the built scene (it has lights and no
+/// environment was given).
+type LoadedParts = (SceneParts, DVec3, bool);
+
+fn build_scene((parts, origin, decide_environment): LoadedParts, warnings: &mut Vec<String>) -> Result<Scene> {
+    let source = parts.source.clone();
     let mut scene = Scene::build(parts);
     scene.origin = origin;
+    if decide_environment {
+        if let Some(line) = light_open_scene(&mut scene) {
+            warnings.push(format!("{}: {line}", source.display()));
+        }
+    }
     scene.warnings = warnings.to_vec();
     Ok(scene)
 }
@@ -160,7 +179,6 @@ fn load_parts(
         material_sources: Vec::new(),
         unlit: Vec::new(),
         default_material: None,
-        colour_variants: HashMap::new(),
         cameras: Vec::new(),
         lights: Vec::new(),
         light_positions: Vec::new(),
@@ -223,8 +241,8 @@ fn parse_gltf(json: serde_json::Value, path: &Path) -> Result<gltf::Document> {
 }
 
 /// The constant environment: `"environment": [r, g, b]` in the scene's extras, else in the
-/// root's (exporters write either); black if neither has one.
-fn scene_environment(path: &Path, scene: &gltf::Scene, doc: &gltf::Document) -> Result<Vec3> {
+/// root's (exporters write either); None if neither has one.
+fn scene_environment(path: &Path, scene: &gltf::Scene, doc: &gltf::Document) -> Result<Option<Vec3>> {
     let places = [("scene", scene.extras().as_ref()), ("root", doc.as_json().extras.as_ref())];
     for (place, raw) in places {
         let Some(raw) = raw else { continue };
@@ -242,9 +260,9 @@ fn scene_environment(path: &Path, scene: &gltf::Scene, doc: &gltf::Document) -> 
                 format!("{place} extras \"environment\" {values:?} must be finite and non-negative")
             ));
         }
-        return Ok(Vec3::from_slice(&values));
+        return Ok(Some(Vec3::from_slice(&values)));
     }
-    Ok(Vec3::ZERO)
+    Ok(None)
 }
 
 impl<'a> Loader<'a> {
@@ -272,15 +290,29 @@ impl<'a> Loader<'a> {
         }
         self.walk_nodes(&scene)?;
         // --env replaces the file's environment; the scene's extras come before the root's.
+        // An environment named by --env or the file, black included, is the author's choice: no
+        // default replaces it.
         let environment = match options.environment {
-            Some(env) => env,
+            Some(env) => Some(env),
             None => scene_environment(self.path, &scene, doc)?,
         };
-        let map = options.environment_map.as_deref().map(EnvironmentMap::load).transpose()?;
+        let map = options
+            .environment_map
+            .as_deref()
+            .map(|p| EnvironmentMap::load(p).map(|m| m.with_rotation(options.env_rotation)))
+            .transpose()?;
+        if options.env_rotation != 0.0 && map.is_none() {
+            self.warn("--env-rotation ignored: it turns an environment map, and there is none");
+        }
+        let (environment, map) = if options.no_environment {
+            (Some(Vec3::ZERO), None)
+        } else {
+            (environment, map)
+        };
         let sources = std::mem::take(&mut self.material_sources);
         // Texel offsets are 32-bit; the device's binding limit is checked at upload.
         let textures = self.load_textures(&sources, 4 * u32::MAX as u64)?;
-        self.finish(environment, map, textures)
+        self.finish(environment, map, textures, options.no_environment)
     }
 
     /// Walks the hierarchy in f64 and re-centres the scene before rounding to f32: on its first
@@ -366,11 +398,18 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn finish(&mut self, environment: Vec3, map: Option<EnvironmentMap>, textures: SceneTextures) -> Result<LoadedParts> {
+    /// The scene's parts; `no_environment` (`--env none`) keeps the default environment off.
+    fn finish(
+        &mut self,
+        environment: Option<Vec3>,
+        map: Option<EnvironmentMap>,
+        textures: SceneTextures,
+        no_environment: bool,
+    ) -> Result<LoadedParts> {
         let this = self;
         let skipped_bounds = this.counts.skipped_bounds;
         // Flat faces without textures need no attributes: their kernels do without.
-        let surfaces = if this.counts.smooth || !textures.is_empty() {
+        let surfaces = if this.counts.smooth || this.counts.vertex_colours || !textures.is_empty() {
             let mut s = std::mem::take(&mut this.surfaces);
             if !s.is_empty() {
                 s.resize(this.triangles.len(), TriangleSurface::flat());
@@ -392,14 +431,16 @@ impl<'a> Loader<'a> {
             .triangles
             .iter()
             .any(|t| Vec3::from(this.materials[t.material as usize].emission).max_element() > 0.0);
-        let mut environment = environment;
-        if !has_emitter && this.lights.is_empty() && environment.max_element() <= 0.0 && map.is_none() {
+        let given = environment.is_some() || map.is_some();
+        let mut environment = environment.unwrap_or(Vec3::ZERO);
+        let unlit = !has_emitter && this.lights.is_empty();
+        if no_environment && unlit {
+            this.warn("the scene has no light and --env none leaves it without an environment: the image is black");
+        } else if unlit && !given {
             environment = DEFAULT_ENVIRONMENT;
-            this.warn(format!(
-                "the scene has no light (no emissive triangle, punctual light or environment): using a uniform environment of radiance {}",
-                DEFAULT_ENVIRONMENT.x
-            ));
+            this.warn(unlit_scene_line());
         }
+        let decide_environment = !no_environment && !unlit && !given;
         if this.cameras.is_empty() {
             let camera = Camera::framing(bounds);
             this.warn(format!(
@@ -422,7 +463,7 @@ impl<'a> Loader<'a> {
             lights: std::mem::take(&mut this.lights),
             warnings: Vec::new(),
         };
-        Ok((parts, this.origin))
+        Ok((parts, this.origin, decide_environment))
     }
 
     /// One warning per kind of thing dropped, with its count over the whole file.
@@ -438,12 +479,6 @@ impl<'a> Loader<'a> {
             self.warn(format!(
                 "{} primitive(s) of points or lines skipped (only triangles, strips and fans are rendered)",
                 c.points_or_lines
-            ));
-        }
-        if c.colour_varying > 0 {
-            self.warn(format!(
-                "COLOR_0 varies within {} triangle(s): each triangle takes the mean of its vertices' colours",
-                c.colour_varying
             ));
         }
     }

@@ -6,7 +6,7 @@ use anyhow::{bail, Result};
 use glam::Vec3;
 
 use super::gltf_loader::{problem, Loader};
-use crate::gpu_types::{Material, MATERIAL_DOUBLE_SIDED};
+use crate::gpu_types::{Material, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION, MATERIAL_DOUBLE_SIDED, MATERIAL_UNLIT};
 use crate::shading::texture::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
 
 /// Specular reflectance at normal incidence of dielectrics in the metallic-roughness model.
@@ -43,10 +43,31 @@ pub fn spec_gloss_to_metal_rough(diffuse: Vec3, specular: Vec3, glossiness: f32)
     (base.clamp(Vec3::ZERO, Vec3::ONE), metallic, (1.0 - glossiness).clamp(0.0, 1.0))
 }
 
+/// The cutoff of a BLEND emitter traversed as MASK: below half of 8-bit alpha's first step, so
+/// that every texel with alpha > 0 is there.
+pub const EMISSIVE_BLEND_CUTOFF: f32 = 0.5 / 255.0;
+
+/// Whether `m` emits (an emissive factor with a positive strength, or unlit).
+fn emits(m: &gltf::Material) -> bool {
+    m.unlit() || m.emissive_factor().iter().any(|&c| c > 0.0) && m.emissive_strength().unwrap_or(1.0) > 0.0
+}
+
+/// The flags by which an emitter's alpha mode weights its emission: `MATERIAL_ALPHA_EMISSION`
+/// for MASK and BLEND, `MATERIAL_BLEND_EMISSION` too for BLEND; 0 otherwise.
+fn emitter_alpha_flags(m: &gltf::Material) -> u32 {
+    use gltf::material::AlphaMode;
+    match m.alpha_mode() {
+        AlphaMode::Mask if emits(m) => MATERIAL_ALPHA_EMISSION,
+        AlphaMode::Blend if emits(m) => MATERIAL_ALPHA_EMISSION | MATERIAL_BLEND_EMISSION,
+        _ => 0,
+    }
+}
+
 impl Loader<'_> {
     /// The alpha mode (`ALPHA_*`) and cutoff traversal applies to material `m`. An emitter
-    /// (emissive factor or unlit) stays opaque, with a warning: light sampling picks points on
-    /// the whole triangle, so a cut-out emitter would still light the scene through its holes.
+    /// keeps MASK; a BLEND emitter is traversed as MASK at [`EMISSIVE_BLEND_CUTOFF`] (present
+    /// where alpha > 0) and emits alpha × its emission ([`emitter_alpha_flags`]), so that every
+    /// estimator, light samples included, sees the same coverage.
     /// A cutoff outside [0, 1] is usable (below 0 every hit counts, above 1 none does) and warned
     /// about; it is kept as written.
     pub(super) fn alpha_test(&mut self, m: &gltf::Material) -> (u32, f32) {
@@ -60,12 +81,8 @@ impl Loader<'_> {
         if mode == AlphaMode::Opaque {
             return (ALPHA_OPAQUE, cutoff);
         }
-        let emits = m.unlit() || m.emissive_factor().iter().any(|&c| c > 0.0) && m.emissive_strength().unwrap_or(1.0) > 0.0;
-        if emits {
-            self.warn(format!(
-                "{name}: alpha mode {mode:?} ignored on an emissive material (emitters are opaque)"
-            ));
-            return (ALPHA_OPAQUE, cutoff);
+        if mode == AlphaMode::Blend && emits(m) {
+            return (ALPHA_MASK, EMISSIVE_BLEND_CUTOFF);
         }
         if mode == AlphaMode::Blend {
             return (ALPHA_BLEND, cutoff);
@@ -181,9 +198,10 @@ impl Loader<'_> {
         if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
             bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));
         }
-        let flags = if m.double_sided() { MATERIAL_DOUBLE_SIDED } else { 0 };
+        let flags = if m.double_sided() { MATERIAL_DOUBLE_SIDED } else { 0 } | emitter_alpha_flags(m);
         if m.unlit() {
             // An unlit surface shows its base colour whatever the lighting: emission, no BSDF.
+            let flags = flags | MATERIAL_UNLIT;
             return Ok(Material {
                 base_color: [0.0; 3],
                 metallic: 0.0,
@@ -228,31 +246,5 @@ impl Loader<'_> {
             self.unlit.push(false);
             (self.materials.len() - 1) as u32
         })
-    }
-
-    /// The material `material` with its base colour (an unlit one: its emission) multiplied by a
-    /// vertex colour; variants are shared between triangles of the same colour.
-    pub(super) fn colour_variant(&mut self, material: u32, colour: Vec3) -> u32 {
-        if colour == Vec3::ONE {
-            return material;
-        }
-        let key = (material, colour.to_array().map(f32::to_bits));
-        if let Some(&v) = self.colour_variants.get(&key) {
-            return v;
-        }
-        let mut m = self.materials[material as usize];
-        if self.unlit[material as usize] {
-            m.emission = (Vec3::from(m.emission) * colour).into();
-        } else {
-            m.base_color = (Vec3::from(m.base_color) * colour).into();
-        }
-        let name = format!("{} × COLOR_0 {:?}", self.material_names[material as usize], colour.to_array());
-        self.materials.push(m);
-        self.material_names.push(name);
-        self.material_sources.push(self.material_sources[material as usize]);
-        self.unlit.push(self.unlit[material as usize]);
-        let v = (self.materials.len() - 1) as u32;
-        self.colour_variants.insert(key, v);
-        v
     }
 }

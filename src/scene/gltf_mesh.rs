@@ -9,10 +9,7 @@ use glam::{DMat4, DQuat, DVec3, Vec3};
 use super::gltf_json::Instancing;
 use super::gltf_loader::{problem, Loader, MAX_TRIANGLES};
 use crate::gpu_types::{Triangle, NO_EMITTER};
-use crate::shading::surface::TriangleSurface;
-
-/// Vertex colours are rounded to this step before materials are shared between triangles.
-const COLOUR_STEP: f32 = 1.0 / 4096.0;
+use crate::shading::surface::{pack_vertex_color, TriangleSurface};
 
 /// Vertex-index triples of the triangles a primitive of `mode` draws from `indices`, in the
 /// winding glTF 2.0 defines (section 3.7.2.1): strips alternate the order of their first two
@@ -179,28 +176,22 @@ impl Loader<'_> {
             };
             let surface = self.read_surface(mesh, &prim, world, &positions, &tris);
             let order = if flip { [0, 2, 1] } else { [0, 1, 2] };
+            self.counts.vertex_colours |= colours.is_some();
             for (k, tri) in tris.iter().enumerate() {
-                let material = match &colours {
-                    Some(c) => self.vertex_colour_material(material, tri.map(|k| c[k as usize])),
-                    None => material,
-                };
                 let [a, b, c] = order.map(|o| placed[tri[o] as usize]);
                 let face = (b - a).cross(c - a).normalize_or_zero().as_vec3();
-                let attributes = surface.as_ref().map(|s| Self::triangle_surface(s, k, *tri, order, face));
+                let mut attributes = surface.as_ref().map(|s| Self::triangle_surface(s, k, *tri, order, face));
+                if let Some(colours) = &colours {
+                    // COLOR_0 is interpolated per hit from the vertices' packed colours.
+                    let (attr, _) = attributes.get_or_insert((TriangleSurface::flat(), false));
+                    for (slot, &o) in order.iter().enumerate() {
+                        attr.normal[slot][3] = pack_vertex_color(colours[tri[o] as usize]);
+                    }
+                }
                 self.push_triangle(a, b, c, material, attributes)?;
             }
         }
         Ok(())
-    }
-
-    /// The material of a triangle with vertex colours: their mean multiplies the base colour.
-    fn vertex_colour_material(&mut self, material: u32, colours: [Vec3; 3]) -> u32 {
-        let mean = (colours[0] + colours[1] + colours[2]) / 3.0;
-        if colours.iter().any(|c| (*c - mean).abs().max_element() > 1.0 / 255.0) {
-            self.counts.colour_varying += 1;
-        }
-        let quantised = (mean.clamp(Vec3::ZERO, Vec3::ONE) / COLOUR_STEP).round() * COLOUR_STEP;
-        self.colour_variant(material, quantised)
     }
 
     /// Adds triangle (a, b, c) in scene coordinates (f64); the edges are taken in f64 before

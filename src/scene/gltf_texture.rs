@@ -9,7 +9,7 @@ use anyhow::{bail, Result};
 
 use super::gltf_loader::{problem, Loader};
 use crate::shading::texture::{
-    texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP,
+    texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, NO_TEXTURE, TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP,
     TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
 };
 
@@ -78,8 +78,8 @@ impl Loader<'_> {
     }
 
     /// The scene's textures (empty when no material uses one): images decoded once each,
-    /// within `max_bytes` of texels. Materials past the file's (the default material, COLOR_0
-    /// variants) copy their source's slots via `material_sources`.
+    /// within `max_bytes` of texels. Materials past the file's (the default material) copy
+    /// their source's slots via `material_sources`.
     pub(super) fn load_textures(&mut self, material_sources: &[Option<usize>], max_bytes: u64) -> Result<SceneTextures> {
         if !self.materials_use_textures() {
             return Ok(SceneTextures::default());
@@ -151,6 +151,10 @@ impl Loader<'_> {
                     h
                 }
             };
+            // A missing image file leaves the slot empty: the factor alone, as viewers draw it.
+            if header == NO_TEXTURE {
+                continue;
+            }
             // The normal texture's transform comes from the extension gltf does not expose.
             let fallback = if k == 3 { normal_xf } else { None };
             let slot = self.texture_slot(r, header, fallback);
@@ -187,7 +191,8 @@ impl Loader<'_> {
         }
     }
 
-    /// Decodes the image of `texture` into `out` with its sampler; returns its header's index.
+    /// Decodes the image of `texture` into `out` with its sampler; returns its header's index, or
+    /// `NO_TEXTURE` (with a warning) for an external image file that cannot be read.
     fn add_texture(&mut self, texture: &gltf::Texture, out: &mut SceneTextures) -> Result<u32> {
         let path = self.path;
         let image = texture
@@ -212,8 +217,18 @@ impl Loader<'_> {
             base.or(Some(std::path::Path::new(".")))
                 .filter(|_| base.is_some() || !matches!(image.source(), gltf::image::Source::Uri { .. })),
             self.buffers,
-        )
-        .map_err(|e| {
+        );
+        if let (Err(gltf::Error::Io(e)), gltf::image::Source::Uri { uri, .. }) = (&data, image.source()) {
+            if !uri.starts_with("data:") {
+                self.warn(format!(
+                    "image {} ({uri}) cannot be read ({e}): the materials using texture {} take their factors alone",
+                    image.index(),
+                    texture.index()
+                ));
+                return Ok(NO_TEXTURE);
+            }
+        }
+        let data = data.map_err(|e| {
             let what = match image.source() {
                 gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => format!("image {} ({uri})", image.index()),
                 _ => format!("image {}", image.index()),

@@ -8,7 +8,7 @@ use super::Scene;
 use crate::gpu_types::Material;
 use crate::shading::alpha::AlphaScene;
 use crate::shading::surface::{surface_at, SurfaceHit, TriangleSurface};
-use crate::shading::texture::{normal_mapped, textured_material, ALPHA_OPAQUE, NO_TEXTURE};
+use crate::shading::texture::{normal_mapped, textured_material, vertex_colored, ALPHA_OPAQUE, NO_TEXTURE};
 
 impl Scene {
     /// What traversal needs to alpha-test hits (the kernels' `SCENE_ALPHA`); `None` when every
@@ -29,14 +29,19 @@ impl Scene {
         surface_at(&self.triangles[triangle as usize], attr, bary)
     }
 
-    /// The material of triangle `triangle` at barycentrics `bary`, its textures applied.
+    /// The material of triangle `triangle` at barycentrics `bary`, its textures and vertex
+    /// colour applied. Twin of GLSL `material_at`.
     pub fn material_at(&self, triangle: u32, bary: Vec2) -> Material {
         let index = self.triangles[triangle as usize].material as usize;
         let m = &self.materials[index];
-        if self.textures.is_empty() || self.surfaces.is_empty() {
+        if self.surfaces.is_empty() {
             return *m;
         }
-        textured_material(m, &self.textures.materials[index], &self.textures, &self.surface_at(triangle, bary))
+        let s = self.surface_at(triangle, bary);
+        if self.textures.is_empty() {
+            return vertex_colored(m, &s);
+        }
+        vertex_colored(&textured_material(m, &self.textures.materials[index], &self.textures, &s), &s)
     }
 
     /// The shading normal of triangle `triangle` at `bary` (unit, scene space, not flipped): the
@@ -58,11 +63,17 @@ impl Scene {
         let index = self.triangles[triangle as usize].material as usize;
         let m = &self.materials[index];
         let s = self.surface_at(triangle, bary);
-        if self.textures.is_empty() || self.surfaces.is_empty() {
+        if self.surfaces.is_empty() {
             return (*m, s.normal);
         }
+        if self.textures.is_empty() {
+            return (vertex_colored(m, &s), s.normal);
+        }
         let t = &self.textures.materials[index];
-        (textured_material(m, t, &self.textures, &s), normal_mapped(t, &self.textures, &s))
+        (
+            vertex_colored(&textured_material(m, t, &self.textures, &s), &s),
+            normal_mapped(t, &self.textures, &s),
+        )
     }
 
     /// Whether any shading normal can differ from the geometric normal: some triangle has vertex

@@ -4,6 +4,7 @@ pub mod alpha_trace;
 pub mod bundled_scenes;
 pub mod bvh;
 mod camera;
+pub mod default_environment;
 pub mod environment;
 mod gltf_budget;
 mod gltf_json;
@@ -17,7 +18,10 @@ mod hit_surface;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
-pub use gltf_loader::{load_scene, load_scene_from_bytes, load_scene_reporting, ArrayLimit, LoadOptions, DEFAULT_ENVIRONMENT};
+pub use gltf_loader::{
+    load_scene, load_scene_from_bytes, load_scene_from_bytes_with_options, load_scene_reporting, ArrayLimit, LoadOptions,
+    DEFAULT_ENVIRONMENT,
+};
 pub use gltf_material::spec_gloss_to_metal_rough;
 pub use gltf_mesh::triangle_indices;
 pub use punctual::{PunctualKind, PunctualLight};
@@ -216,6 +220,18 @@ impl Scene {
     pub fn punctual_rows(&self) -> Vec<Emitter> {
         let pdfs: Vec<f32> = (0..self.lights.len()).map(|k| self.light_select_pdf(k)).collect();
         crate::gpu_types::punctual_rows(&self.lights, &pdfs)
+    }
+
+    /// Replaces the environment by the constant radiance `env` (no map), with the light
+    /// selection's environment probability chosen as [`Scene::build`] chooses it.
+    pub fn set_environment(&mut self, env: Vec3) {
+        self.environment = env;
+        self.environment_map = None;
+        self.env_select_prob = match (luminance(env) > 0.0, self.emitters.is_empty()) {
+            (false, _) => 0.0,
+            (true, true) => 1.0,
+            (true, false) => ENV_SELECT_PROB_WITH_EMITTERS,
+        };
     }
 
     /// The largest side of the scene's bounds (scene units).

@@ -13,7 +13,7 @@ pub enum PunctualKind {
     /// Emits the same intensity in every direction from `position`.
     Point = 0,
     /// A point light restricted to a cone around `direction`, with a smooth edge between the inner
-    /// and outer angles.
+    /// and outer angles (a hard edge where they are equal, as Blender writes a spot of blend 0).
     Spot = 1,
     /// Parallel light along `direction` from infinitely far away, e.g. the sun.
     Directional = 2,
@@ -86,8 +86,10 @@ impl Loader<'_> {
                 inner_cone_angle,
                 outer_cone_angle,
             } => {
+                // Blender writes inner = outer for a spot of blend 0; viewers draw a hard edge.
+                let hard_edge = inner_cone_angle == outer_cone_angle;
                 let ok = (0.0..=std::f32::consts::FRAC_PI_2).contains(&outer_cone_angle)
-                    && (0.0..outer_cone_angle.max(f32::MIN_POSITIVE)).contains(&inner_cone_angle);
+                    && (hard_edge || (0.0..outer_cone_angle.max(f32::MIN_POSITIVE)).contains(&inner_cone_angle));
                 if !ok {
                     bail!(problem(
                         self.path,
@@ -95,6 +97,12 @@ impl Loader<'_> {
                             "spot light on node {}: cone angles must satisfy 0 <= inner < outer <= pi/2 (inner {inner_cone_angle}, outer {outer_cone_angle})",
                             node.index()
                         )
+                    ));
+                }
+                if hard_edge {
+                    self.warn(format!(
+                        "spot light on node {}: innerConeAngle equals outerConeAngle ({outer_cone_angle}); the schema asks inner < outer, drawn as a hard-edged cone",
+                        node.index()
                     ));
                 }
                 (PunctualKind::Spot, inner_cone_angle.cos(), outer_cone_angle.cos())

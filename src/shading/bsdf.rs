@@ -150,11 +150,13 @@ pub fn refract_dir(w: Vec3, m: Vec3, eta: f32) -> Option<(Vec3, f32)> {
 }
 
 /// The split by metallic and transmission factors: (non-metal (diffuse base and its specular
-/// layer), conductor, dielectric), summing to 1.
+/// layer), conductor, dielectric), summing to 1. `KHR_materials_transmission` replaces only the
+/// non-metal part (the extension: metals are not transmissive), so the split is
+/// mix(mix(base, dielectric, t), conductor, metallic). Twin of GLSL `lobe_weights`.
 pub fn lobe_weights(m: &Material) -> (f32, f32, f32) {
     let t = m.transmission.clamp(0.0, 1.0);
     let k = m.metallic.clamp(0.0, 1.0);
-    ((1.0 - t) * (1.0 - k), (1.0 - t) * k, t)
+    ((1.0 - t) * (1.0 - k), k, t * (1.0 - k))
 }
 
 /// Whether the material's non-metal part has a specular layer (`specular_layer_fresnel` is not

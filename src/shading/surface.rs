@@ -20,7 +20,7 @@ use crate::shading::sampling::build_onb;
 pub struct TriangleSurface {
     /// xyz: the vertex normal (unit, or zero where the file gave none or the triangle is flat:
     /// the face normal is used);
-    /// w: unused.
+    /// w: the vertex's COLOR_0 packed by [`pack_vertex_color`] (its bits; 0.0: no colour).
     pub normal: [[f32; 4]; 3],
     /// xyz: the vertex tangent (along +u of the normal texture's coordinates); w: its handedness
     /// ±1, the bitangent being w · cross(normal, tangent) (glTF 2.0, section 3.7.2.1).
@@ -34,6 +34,24 @@ impl TriangleSurface {
     pub fn flat() -> Self {
         Self::default()
     }
+}
+
+/// [`pack_vertex_color`]'s flag bit: the vertex has a colour.
+const VERTEX_COLOR_PRESENT: u32 = 1 << 31;
+
+/// A COLOR_0 value (linear RGB, clamped to [0, 1]) as the bits of an f32 kept in a vertex
+/// normal's unused w: 10 bits per channel (R in bits 0-9, G 10-19, B 20-29, rounded to
+/// 1/1023), bit 31 set to say the vertex has one. Bit 30 stays clear, so the exponent is never
+/// all ones: the value is never a NaN or an infinity that a copy could alter.
+pub fn pack_vertex_color(c: Vec3) -> f32 {
+    let q = (c.clamp(Vec3::ZERO, Vec3::ONE) * 1023.0).round();
+    f32::from_bits(VERTEX_COLOR_PRESENT | q.x as u32 | (q.y as u32) << 10 | (q.z as u32) << 20)
+}
+
+/// The colour of one vertex's packed value, or None (no colour).
+fn unpack_vertex_color(w: f32) -> Option<Vec3> {
+    let b = w.to_bits();
+    (b & VERTEX_COLOR_PRESENT != 0).then(|| Vec3::new((b & 1023) as f32, ((b >> 10) & 1023) as f32, ((b >> 20) & 1023) as f32) / 1023.0)
 }
 
 /// The surface at a hit: the shading frame and texture coordinates.
@@ -51,6 +69,9 @@ pub struct SurfaceHit {
     pub uv0: Vec2,
     /// Interpolated TEXCOORD_1; zero if absent.
     pub uv1: Vec2,
+    /// Interpolated COLOR_0 (linear RGB), which multiplies the base colour; 1 where the
+    /// vertices have none.
+    pub color: Vec3,
 }
 
 /// Barycentrics (b1, b2) of point `p` (on or near the triangle's plane) in `tri`: the
@@ -93,5 +114,17 @@ pub fn surface_at(tri: &Triangle, attr: &TriangleSurface, bary: Vec2) -> Surface
         handedness: if t4.w < 0.0 { -1.0 } else { 1.0 },
         uv0: Vec2::new(uv.x, uv.y),
         uv1: Vec2::new(uv.z, uv.w),
+        color: vertex_color(attr, w),
+    }
+}
+
+/// COLOR_0 at vertex weights `w` (b0, b1, b2): the vertices' colours interpolated, as glTF
+/// interpolates every vertex attribute; 1 where the first vertex has none (a primitive's
+/// vertices all have one or none). Twin of GLSL `vertex_color`.
+pub fn vertex_color(attr: &TriangleSurface, w: Vec3) -> Vec3 {
+    let c = attr.normal.map(|n| unpack_vertex_color(n[3]));
+    match c {
+        [Some(a), Some(b), Some(d)] => a * w.x + b * w.y + d * w.z,
+        _ => Vec3::ONE,
     }
 }

@@ -7,7 +7,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::gpu_types::Material;
+use crate::gpu_types::{Material, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION};
 use crate::shading::surface::SurfaceHit;
 
 /// [`TextureSlot::texture_index`] of a slot without a texture: the factor applies alone.
@@ -227,6 +227,35 @@ pub fn textured_material(m: &Material, t: &MaterialTextures, textures: &SceneTex
         let c = texture_lookup(textures, t.emissive.texture_index, texture_coordinates(&t.emissive, s), true);
         out.emission = (Vec3::from(m.emission) * c.truncate()).into();
     }
+    if m.flags & MATERIAL_ALPHA_EMISSION != 0 {
+        out.emission = (Vec3::from(out.emission) * emission_coverage(m, t, textures, s)).into();
+    }
+    out
+}
+
+/// The share of an alpha-tested emitter's emission at `s` (`MATERIAL_ALPHA_EMISSION`): 0 where
+/// its alpha is below the cutoff traversal uses (no surface there), else 1, or the alpha itself
+/// for a BLEND emitter (`MATERIAL_BLEND_EMISSION`). Twin of GLSL `emission_coverage`.
+pub fn emission_coverage(m: &Material, t: &MaterialTextures, textures: &SceneTextures, s: &SurfaceHit) -> f32 {
+    let a = material_alpha(t, textures, s);
+    if !(a >= t.alpha_cutoff) {
+        0.0
+    } else if m.flags & MATERIAL_BLEND_EMISSION != 0 {
+        a
+    } else {
+        1.0
+    }
+}
+
+/// `m` with the vertex colour of `s` applied: COLOR_0 multiplies the base colour (glTF 2.0
+/// section 3.9.2), and the emission of a `KHR_materials_unlit` material, which is its base colour
+/// ([`crate::gpu_types::MATERIAL_UNLIT`]). Twin of GLSL `vertex_colored`.
+pub fn vertex_colored(m: &Material, s: &SurfaceHit) -> Material {
+    let mut out = *m;
+    out.base_color = (Vec3::from(m.base_color) * s.color).into();
+    if m.flags & crate::gpu_types::MATERIAL_UNLIT != 0 {
+        out.emission = (Vec3::from(m.emission) * s.color).into();
+    }
     out
 }
 
@@ -240,12 +269,42 @@ pub fn normal_mapped(t: &MaterialTextures, textures: &SceneTextures, s: &Surface
     }
     let c = texture_lookup(textures, t.normal.texture_index, texture_coordinates(&t.normal, s), false);
     let local = (c.truncate() * 2.0 - Vec3::ONE) * Vec3::new(t.normal_scale, t.normal_scale, 1.0);
-    let bitangent = s.handedness * s.normal.cross(s.tangent);
-    let n = s.tangent * local.x + bitangent * local.y + s.normal * local.z;
+    let (tangent, handedness) = texture_tangent_frame(&t.normal, s);
+    let bitangent = handedness * s.normal.cross(tangent);
+    let n = tangent * local.x + bitangent * local.y + s.normal * local.z;
     if n.length_squared() > 1e-12 {
         n.normalize()
     } else {
         s.normal
+    }
+}
+
+/// The tangent and handedness of the coordinates `slot` looks its texture up with, from the
+/// surface's (those of its texture coordinates): KHR_texture_transform's linear part A (rows
+/// `u_row`, `v_row`) turns, scales or mirrors the lookup, and a tangent-space normal is relative
+/// to the texture's axes, so the frame turns with it. The tangent becomes ∂P/∂u' of the
+/// transformed coordinates, A⁻¹'s first column on the frame (with the bitangent
+/// `handedness · cross(n, t)` along −v, up the image): normalize((A₁₁ t + A₁₀ b) / det A); the
+/// handedness flips with det A < 0. This is the frame MikkTSpace gives coordinates with the
+/// transform baked in. Untouched (bit for bit) without a rotation, where A₁₀ = 0; unchanged for a
+/// singular A. Twin of GLSL `texture_tangent_frame`.
+pub fn texture_tangent_frame(slot: &TextureSlot, s: &SurfaceHit) -> (Vec3, f32) {
+    let (a00, a01, a10, a11) = (slot.u_row[0], slot.u_row[1], slot.v_row[0], slot.v_row[1]);
+    let det = a00 * a11 - a01 * a10;
+    if det == 0.0 || !det.is_finite() {
+        return (s.tangent, s.handedness);
+    }
+    let sign = if det < 0.0 { -1.0 } else { 1.0 };
+    if a10 == 0.0 {
+        let flip = if a11 * sign < 0.0 { -1.0 } else { 1.0 };
+        return (s.tangent * flip, s.handedness * sign);
+    }
+    let bitangent = s.handedness * s.normal.cross(s.tangent);
+    let t = (s.tangent * a11 + bitangent * a10) * sign;
+    if t.length_squared() > 1e-12 {
+        (t.normalize(), s.handedness * sign)
+    } else {
+        (s.tangent, s.handedness)
     }
 }
 

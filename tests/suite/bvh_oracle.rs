@@ -321,10 +321,18 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
 /// The environment half of light sampling with an equirectangular map (the scene's emitters beside
 /// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (lights.glsl, compiled
 /// with the scene's SCENE_ENV_MAP defines) against their Rust twins in src/shading/lights.rs.
+/// Run unrotated and turned by 37 degrees (`--env-rotation`, the header's cosine and sine).
 #[test]
 fn environment_map_light_sampling_glsl_matches_rust() {
+    for degrees in [0.0, 37.0] {
+        environment_map_light_sampling_matches(degrees);
+    }
+}
+
+fn environment_map_light_sampling_matches(degrees: f32) {
     let ctx = gpu();
-    let scene = random_scene_full(5, vec![], Some(crate::sampling_statistics::test_environment_map()));
+    let map = crate::sampling_statistics::test_environment_map().with_rotation(degrees);
+    let scene = random_scene_full(5, vec![], Some(map));
     assert!(scene.env_select_prob > 0.0 && scene.env_select_prob < 1.0);
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
     let params = params_buffer(&scene_gpu, &oracle_settings());
@@ -383,7 +391,9 @@ fn check_environment_sample(scene: &Scene, ls: &LightSample, g3: Vec4, i: usize)
     // The map is piecewise constant: radiance and pdf must agree unless the direction
     // sits within 0.005 texels of a texel edge, where llvmpipe's atan/acos and Rust's
     // may round to different texels.
-    let uv = restir_pt::scene::environment::equirect_uv(ls.dir) * Vec2::new(24.0, 12.0);
+    use restir_pt::scene::environment::{env_rotate, equirect_uv};
+    let cs = scene.environment_map.as_ref().unwrap().rotation;
+    let uv = equirect_uv(env_rotate(ls.dir, Vec2::new(cs.x, -cs.y))) * Vec2::new(24.0, 12.0);
     if (uv - uv.round()).abs().min_element() < 5e-3 {
         return false;
     }

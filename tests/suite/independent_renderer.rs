@@ -22,7 +22,7 @@ use std::sync::atomic::AtomicBool;
 
 use glam::{Quat, Vec3};
 use restir_pt::render::{Image, PathTracer, RenderSettings, SceneGpu};
-use restir_pt::scene::load_scene_from_bytes;
+use restir_pt::scene::{load_scene_from_bytes_with_options, LoadOptions};
 use serde_json::{json, Value};
 
 use crate::common::{assert_clean, gpu, repo_path};
@@ -50,6 +50,8 @@ struct Reference {
     lambertian: bool,
     emissive: bool,
     sun: Option<[f32; 5]>,
+    /// The environment radiance the reference rendered with (the tool's default rule).
+    environment: Option<Vec3>,
     tile_mean: Vec<Vec3>,
     tile_se: Vec<Vec3>,
 }
@@ -80,6 +82,9 @@ fn read_reference(name: &str) -> Reference {
         lambertian: s["lambertian"].as_bool().unwrap(),
         emissive: s["emissive"].as_bool().unwrap_or(false),
         sun,
+        environment: s["environment"]
+            .as_array()
+            .map(|a| Vec3::from_slice(&a.iter().map(|x| x.as_f64().unwrap() as f32).collect::<Vec<_>>())),
         tile_mean: vec3s(&v["tile_mean_rgb"]),
         tile_se: vec3s(&v["tile_mean_rgb_se"]),
     }
@@ -156,7 +161,13 @@ fn render(reference: &Reference, spp: u32) -> Image {
     }
     let text = serde_json::to_vec(&doc).unwrap();
     let dir = reference.source.parent().unwrap();
-    let scene = load_scene_from_bytes(&text, Some(dir), &reference.source).unwrap();
+    // The environment the reference had: the tool decides the default by its own rule (a file
+    // without light gets radiance 1), which restir-pt's open-asset rule need not repeat.
+    let options = LoadOptions {
+        environment: reference.environment,
+        ..Default::default()
+    };
+    let scene = load_scene_from_bytes_with_options(&text, Some(dir), &reference.source, &options).unwrap();
     let ctx = gpu();
     let settings = RenderSettings {
         width: reference.width,

@@ -114,6 +114,25 @@ fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<StructLayou
     checked
 }
 
+/// The records of set 1 (glsl/surface_bindings.glsl): per-triangle attributes, whose normals'
+/// w carries the packed COLOR_0 (`surface::pack_vertex_color`), and the texture records.
+fn surface_structs() -> Vec<StructLayout> {
+    use restir_pt::shading::surface::TriangleSurface;
+    use restir_pt::shading::texture::{MaterialTextures, TextureHeader, TextureSlot};
+    vec![
+        rust_fields!(TriangleSurface: normal, tangent, uv),
+        rust_fields!(TextureHeader: width, height, offset, sampler_bits),
+        rust_fields!(TextureSlot: u_row, texture_index, v_row, texcoord),
+        rust_fields!(MaterialTextures: base_color, metal_rough, emissive, normal, normal_scale, alpha_cutoff, alpha_mode, base_alpha),
+    ]
+}
+
+#[test]
+fn surface_records_match_glsl_layout() {
+    let textured = [("SCENE_SURFACE", "1"), ("SCENE_TEXTURES", "1"), ("SCENE_SHADING_NORMALS", "1")];
+    assert!(check_layout("pathtrace.comp", &textured, surface_structs()) >= 4);
+}
+
 #[test]
 fn gpu_types_match_glsl_layout_in_storage_and_uniform_bindings() {
     assert!(check_layout("pathtrace.comp", &[], scene_structs()) >= 5);

@@ -11,7 +11,7 @@
 use glam::Vec3;
 use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu, ShiftKind};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
-use restir_pt::scene::{load_scene, Scene};
+use restir_pt::scene::{load_scene_reporting, LoadOptions, Scene};
 use restir_pt::shading::lights::spot_falloff;
 use serde_json::{json, Value};
 
@@ -34,7 +34,12 @@ fn plane_scene(name: &str, light: Value, position: Vec3, direction: Vec3) -> Sce
     b.punctual_light(light, position, direction);
     b.camera("camera", Vec3::new(0.0, 2.5, 2.5), Vec3::ZERO, 0.9);
     let path = temp_file(name, b.finish(name, Vec3::ZERO).as_bytes());
-    let scene = load_scene(&path).unwrap();
+    // An open plane: the default environment would join the light (`--env none` keeps it out).
+    let options = LoadOptions {
+        no_environment: true,
+        ..Default::default()
+    };
+    let scene = load_scene_reporting(&path, &options, &mut Vec::new()).unwrap();
     assert_eq!(scene.environment, Vec3::ZERO, "the light must be the only one");
     assert_eq!(scene.lights.len(), 1);
     scene
@@ -216,4 +221,60 @@ fn punctual_point_light_restir_matches_the_closed_form_irradiance() {
         );
     }
     assert_clean(&ctx);
+}
+
+/// Blender writes innerConeAngle = outerConeAngle for a spot of blend 0: loaded with a warning
+/// as a hard-edged cone (the falloff's ramp is 1e-3 wide in cos θ, under a tenth of a degree
+/// here), rendered without a non-finite pixel and matching the closed form; the pixels the cone's
+/// edge crosses are the only ones between dark and lit.
+#[test]
+fn punctual_spot_with_equal_cone_angles_is_a_hard_edged_cone() {
+    let light = json!({ "type": "spot", "intensity": 3.0, "spot": { "innerConeAngle": 0.7, "outerConeAngle": 0.7 } });
+    let scene = plane_scene("hard-spot.gltf", light, Vec3::new(-0.2, 1.2, 0.1), Vec3::new(0.1, -1.0, 0.05));
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("innerConeAngle equals outerConeAngle")),
+        "{:?}",
+        scene.warnings
+    );
+    let l = &scene.lights[0];
+    assert_eq!(l.cos_inner, l.cos_outer);
+    // The falloff is 0 outside, 1 a tenth of a degree inside, and finite on the edge itself.
+    let at = |angle: f32| {
+        let (x, _) = restir_pt::shading::sampling::build_onb(l.direction);
+        spot_falloff(l, (l.direction * angle.cos() + x * angle.sin()).normalize())
+    };
+    assert_eq!(at(0.7 + 1e-3), 0.0);
+    assert_eq!(at(0.7 - 0.1f32.to_radians()), 1.0);
+    assert!(at(0.7).is_finite());
+    let image = path_traced(&scene, 256);
+    assert_eq!(image.non_finite_count(), 0);
+    let (n, worst, sum) = compare(&scene, &image, "hard-edged spot", 0.01);
+    // Pixels are either dark (outside), lit (inside) or cut by the edge: no soft ring.
+    let peak = image.mean.iter().map(|m| m.x).fold(0.0, f32::max);
+    let mut partial = 0;
+    for y in 0..SIDE {
+        for x in 0..SIDE {
+            let hits = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(dx, dy)| plane_hit(&scene, x as f32 + dx, y as f32 + dy));
+            if hits.iter().any(Option::is_none) {
+                continue;
+            }
+            let (expected, _) = pixel_mean(&scene, x, y);
+            let corners = hits.map(|p| closed_form(&scene, p.unwrap()).x);
+            let cut = corners.contains(&0.0) && corners.iter().any(|&c| c > 0.0);
+            partial += cut as u32;
+            if !cut {
+                let got = image.mean[(y * SIDE + x) as usize].x;
+                assert!(got < 1e-6 || expected.x > 0.0, "pixel ({x}, {y}) outside the cone is lit: {got}");
+                assert!(
+                    expected.x == 0.0 || got > 0.05 * peak || expected.x < 0.05 * peak,
+                    "pixel ({x}, {y})"
+                );
+            }
+        }
+    }
+    eprintln!(
+        "hard-edged spot: {n} pixels within {:.3}% (sum {:.3}%), {partial} pixels cut by the edge",
+        100.0 * worst,
+        100.0 * sum
+    );
 }

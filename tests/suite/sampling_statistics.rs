@@ -221,10 +221,18 @@ pub fn test_environment_map() -> restir_pt::scene::environment::EnvironmentMap {
 /// row centre, normalised), at the 1% level; every sampled direction lands in a texel of positive
 /// probability, and the pdf integrates to 1 over the sphere (uniform-sphere Monte Carlo, 4
 /// standard errors).
+/// Run unrotated and turned by -120 degrees (`--env-rotation`): texels are counted in the map's
+/// own frame, so the rotation must leave every count where it was.
 #[test]
 fn environment_map_sampling_chi_square_and_pdf() {
-    use restir_pt::scene::environment::equirect_uv;
-    let map = test_environment_map();
+    for degrees in [0.0, -120.0] {
+        environment_map_sampling_fits(test_environment_map().with_rotation(degrees));
+    }
+}
+
+fn environment_map_sampling_fits(map: restir_pt::scene::environment::EnvironmentMap) {
+    use restir_pt::scene::environment::{env_rotate, equirect_uv};
+    let undo = Vec2::new(map.rotation.x, -map.rotation.y);
     let (w, h) = (map.width as usize, map.height as usize);
     let weight: Vec<f64> = (0..w * h)
         .map(|k| {
@@ -238,7 +246,7 @@ fn environment_map_sampling_chi_square_and_pdf() {
     for _ in 0..SAMPLES {
         let d = map.sample_environment(Vec2::new(r.uniform(), r.uniform()));
         assert!((d.length() - 1.0).abs() < 1e-4);
-        let uv = equirect_uv(d);
+        let uv = equirect_uv(env_rotate(d, undo));
         let (i, j) = (((uv.y * h as f32) as usize).min(h - 1), ((uv.x * w as f32) as usize).min(w - 1));
         observed[i * w + j] += 1.0;
         assert!(map.pdf(d) > 0.0, "a sample at {d} has pdf 0");
@@ -257,4 +265,50 @@ fn environment_map_sampling_chi_square_and_pdf() {
     let values: Vec<f64> = (0..n).map(|_| map.pdf(r.unit_vector()) as f64 * 4.0 * PI).collect();
     let (mean, se) = (mean(values.iter().copied()), standard_error(&values).unwrap());
     assert!((mean - 1.0).abs() < 4.0 * se, "pdf integrates to {mean} +- {se}");
+}
+
+/// The map's orientation is Mitsuba 3's (src/scene/environment.rs): the centre column faces +Z,
+/// u = 1/4 faces +X, the left edge -Z, the top row +Y; `--env-rotation 90` brings the centre
+/// column to +X (right-handed about +Y), and radiance, pdf and sampling turn together.
+#[test]
+fn environment_map_orientation_is_mitsubas_and_rotation_turns_it_about_up() {
+    use restir_pt::scene::environment::{equirect_dir, equirect_uv, EnvironmentMap};
+    let close = |a: Vec2, b: Vec2| (a - b).abs().max_element() < 1e-6;
+    assert!(close(equirect_uv(Vec3::Z), Vec2::new(0.5, 0.5)));
+    assert!(close(equirect_uv(Vec3::X), Vec2::new(0.25, 0.5)));
+    assert!(close(equirect_uv(-Vec3::X), Vec2::new(0.75, 0.5)));
+    assert!(equirect_uv(-Vec3::Z).x.abs() < 1e-6 || (equirect_uv(-Vec3::Z).x - 1.0).abs() < 1e-6);
+    assert!(close(equirect_uv(Vec3::Y), Vec2::new(0.5, 0.0)) || equirect_uv(Vec3::Y).y.abs() < 1e-6);
+    for uv in [Vec2::new(0.1, 0.3), Vec2::new(0.6, 0.8), Vec2::new(0.95, 0.5)] {
+        assert!(close(equirect_uv(equirect_dir(uv)), uv), "{uv}");
+    }
+    // Two bright texel columns around the centre (u in [7/16, 9/16)): they must light +Z
+    // unrotated, +X at 90.
+    let (w, h) = (16u32, 8u32);
+    let texels: Vec<Vec3> = (0..w * h)
+        .map(|k| {
+            if k % w == 7 || k % w == 8 {
+                Vec3::splat(10.0)
+            } else {
+                Vec3::splat(0.1)
+            }
+        })
+        .collect();
+    let map = EnvironmentMap::new(w, h, texels).unwrap();
+    assert_eq!(map.radiance(Vec3::new(0.01, 0.0, 1.0).normalize()), Vec3::splat(10.0));
+    assert_eq!(map.radiance(Vec3::X), Vec3::splat(0.1));
+    let turned = map.clone().with_rotation(90.0);
+    assert_eq!(turned.radiance(Vec3::new(1.0, 0.0, -0.01).normalize()), Vec3::splat(10.0));
+    assert_eq!(turned.radiance(Vec3::Z), Vec3::splat(0.1));
+    let mut r = TestRng(5);
+    // Rounding can move a direction within ~1e-7 of a texel edge across it: at most a few.
+    let mut differ = 0;
+    for _ in 0..1000 {
+        let d = r.unit_vector();
+        let e = restir_pt::scene::environment::env_rotate(d, turned.rotation);
+        differ += (turned.radiance(e) != map.radiance(d) || (turned.pdf(e) - map.pdf(d)).abs() > 1e-4 * map.pdf(d)) as u32;
+        let s = turned.sample_environment(Vec2::new(r.uniform(), r.uniform()));
+        assert!(turned.radiance(s) == Vec3::splat(10.0) || turned.radiance(s) == Vec3::splat(0.1));
+    }
+    assert!(differ <= 3, "{differ} of 1000 directions differ");
 }

@@ -120,7 +120,13 @@ fn plane_scene(plane: &Plane) -> Scene {
     b.camera("above", Vec3::new(0.5, 0.5, 2.0), Vec3::new(0.5, 0.5, 0.0), 0.3);
     let environment = if plane.light.is_some() { Vec3::ZERO } else { Vec3::ONE };
     let text = b.finish("tilted plane", environment);
-    load_scene_from_bytes(text.as_bytes(), None, std::path::Path::new("tilted plane.gltf")).unwrap()
+    // Under the light, the light alone (--env none: no default environment for the open plane).
+    let options = restir_pt::scene::LoadOptions {
+        no_environment: plane.light.is_some(),
+        ..Default::default()
+    };
+    restir_pt::scene::load_scene_from_bytes_with_options(text.as_bytes(), None, std::path::Path::new("tilted plane.gltf"), &options)
+        .unwrap()
 }
 
 fn render(scene: &Scene, side: u32, spp: u32) -> Image {

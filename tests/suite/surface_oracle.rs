@@ -1,17 +1,19 @@
 //! GLSL surface.glsl, texture.glsl and shading_frame.glsl against src/surface.rs, src/texture.rs
 //! and src/scene/hit_surface.rs: surface_at, triangle_bary, texture_lookup, texture_coordinates,
-//! textured_material, normal_mapped, shading_normal and hit_shading (Scene methods) on a
-//! scene of random triangles with random vertex attributes and small random textures (every
-//! address mode, bilinear and nearest, sRGB and linear, KHR_texture_transform rows).
+//! textured_material (with emission_coverage), normal_mapped, texture_tangent_frame (the normal
+//! texture's frame turned and mirrored with its transform), vertex_color, shading_normal and
+//! hit_shading (Scene methods) on a scene of random triangles with random vertex attributes
+//! (COLOR_0 on half of them) and small random textures (every address mode, bilinear and
+//! nearest, sRGB and linear, KHR_texture_transform rows).
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
+use restir_pt::gpu_types::{Material, Triangle, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION, NO_EMITTER};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
-use restir_pt::shading::surface::{surface_at, triangle_bary, SurfaceHit, TriangleSurface};
+use restir_pt::shading::surface::{pack_vertex_color, surface_at, triangle_bary, SurfaceHit, TriangleSurface};
 use restir_pt::shading::texture::{
-    normal_mapped, texture_coordinates, texture_lookup, textured_material, MaterialTextures, SceneTextures, TextureHeader, TextureSlot,
-    NO_TEXTURE, TEXTURE_NEAREST,
+    normal_mapped, texture_coordinates, texture_lookup, texture_tangent_frame, textured_material, MaterialTextures, SceneTextures,
+    TextureHeader, TextureSlot, NO_TEXTURE, TEXTURE_NEAREST,
 };
 
 use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_surface_set0_oracle, TestRng};
@@ -22,7 +24,7 @@ const MATERIALS: usize = 7;
 /// Relative agreement; sRGB decoding goes through llvmpipe's pow.
 const TOL: f32 = 2e-4;
 /// vec4 outputs per item (OUT_ROWS in surface_oracle.comp).
-const ROWS: usize = 10;
+const ROWS: usize = 12;
 
 fn random_textures(r: &mut TestRng) -> SceneTextures {
     let mut t = SceneTextures::default();
@@ -38,14 +40,20 @@ fn random_textures(r: &mut TestRng) -> SceneTextures {
         });
         t.texels.extend((0..w * h).map(|_| r.next_u64() as u32));
     }
-    let slot = |r: &mut TestRng| {
+    // Draws added since the scene was first written come from their own stream, so that the
+    // triangles and textures stay those of the original seed.
+    let mut extra = TestRng(0x5eed_0001);
+    let mut slot = |r: &mut TestRng| {
         if r.uniform() < 0.2 {
             return TextureSlot::default();
         }
+        // Turned, scaled and (a quarter of them) mirrored: the normal slot's tangent frame
+        // turns and flips with the transform (texture_tangent_frame).
+        let mirror = if extra.uniform() < 0.25 { -1.0 } else { 1.0 };
         let (u_row, v_row) = restir_pt::shading::texture::texture_transform_rows(
             [r.uniform() - 0.5, r.uniform() - 0.5],
             (r.uniform() - 0.5) * 6.0,
-            [0.2 + 2.0 * r.uniform(), 0.2 + 2.0 * r.uniform()],
+            [mirror * (0.2 + 2.0 * r.uniform()), 0.2 + 2.0 * r.uniform()],
         );
         TextureSlot {
             u_row,
@@ -70,7 +78,7 @@ fn random_textures(r: &mut TestRng) -> SceneTextures {
     t
 }
 
-fn random_attributes(r: &mut TestRng) -> TriangleSurface {
+fn random_attributes(r: &mut TestRng, extra: &mut TestRng) -> TriangleSurface {
     let mut a = TriangleSurface::flat();
     for k in 0..3 {
         if r.uniform() < 0.9 {
@@ -81,6 +89,12 @@ fn random_attributes(r: &mut TestRng) -> TriangleSurface {
         }
         a.uv[k] = [0, 1, 2, 3].map(|_| 6.0 * r.uniform() - 3.0);
     }
+    // Vertex colours (COLOR_0) on half of the triangles, all three vertices or none.
+    if extra.uniform() < 0.5 {
+        for k in 0..3 {
+            a.normal[k][3] = pack_vertex_color(Vec3::new(extra.uniform(), extra.uniform(), extra.uniform()));
+        }
+    }
     a
 }
 
@@ -88,6 +102,7 @@ pub fn textured_random_scene(seed: u64) -> Scene {
     let mut r = TestRng(seed);
     let mut triangles = Vec::new();
     let mut surfaces = Vec::new();
+    let mut extra = TestRng(seed ^ 0x00c0_10c0);
     for i in 0..500 {
         let c = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
         let v: Vec<Vec3> = (0..3).map(|_| c + (0.1 + r.uniform()) * r.unit_vector()).collect();
@@ -99,15 +114,19 @@ pub fn textured_random_scene(seed: u64) -> Scene {
             e2: (v[2] - v[0]).into(),
             alpha_tested: 0,
         });
-        surfaces.push(random_attributes(&mut r));
+        surfaces.push(random_attributes(&mut r, &mut extra));
     }
+    // Every third material an alpha-tested emitter (MASK), every third a BLEND one: emission
+    // times its coverage (emission_coverage).
+    let coverage_flags = [0, MATERIAL_ALPHA_EMISSION, MATERIAL_ALPHA_EMISSION | MATERIAL_BLEND_EMISSION];
     let materials = (0..MATERIALS)
-        .map(|_| Material {
+        .map(|k| Material {
             base_color: [r.uniform(), r.uniform(), r.uniform()],
             metallic: r.uniform(),
             emission: [r.uniform(), r.uniform(), r.uniform()],
             roughness: r.uniform(),
             ior: 1.5,
+            flags: coverage_flags[k % 3],
             ..Default::default()
         })
         .collect();
@@ -251,6 +270,10 @@ fn check_item(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize) -> bool {
     );
     check_textured_material(scene, material, &s, g, i);
     check_shading_frame(scene, &g[8..10], tri, bary, i);
+    let (tangent, handedness) = texture_tangent_frame(&mt.normal, &s);
+    assert_vec3_close(format!("texture_tangent_frame tangent, item {i}"), g[10].truncate(), tangent, 1e-3);
+    assert_eq!(g[10].w, handedness, "texture_tangent_frame handedness, item {i}");
+    assert_vec3_close(format!("vertex_color, item {i}"), g[11].truncate(), s.color, 1e-5);
     true
 }
 
