@@ -65,16 +65,27 @@ fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
 #[pymethods]
 impl PyScene {
     /// Loads `path` (.gltf or .glb); `scene` picks one of the file's scenes, `env` replaces its
-    /// environment ((r, g, b) or an .exr/.hdr map). The loader's warnings are issued as
-    /// `SceneWarning`s (also when the load then fails); errors raise `SceneError`.
+    /// environment ((r, g, b), an .exr/.hdr map, or "none" for no default sky), `env_rotation`
+    /// turns a map about the up axis (degrees, as the CLI's --env-rotation). The loader's
+    /// warnings are issued as `SceneWarning`s (also when the load then fails); errors raise
+    /// `SceneError`.
     #[new]
-    #[pyo3(signature = (path, *, scene = None, env = None))]
-    fn new(py: Python<'_>, path: PathBuf, scene: Option<usize>, env: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
-        let (environment, environment_map) = environment(env)?;
+    #[pyo3(signature = (path, *, scene = None, env = None, env_rotation = 0.0))]
+    fn new(py: Python<'_>, path: PathBuf, scene: Option<usize>, env: Option<&Bound<'_, PyAny>>, env_rotation: f32) -> PyResult<Self> {
+        let no_environment = env.is_some_and(|e| e.extract::<String>().is_ok_and(|s| s == "none"));
+        let (environment, environment_map) = if no_environment { (None, None) } else { environment(env)? };
+        if !env_rotation.is_finite() {
+            return Err(error_of(
+                Kind::Settings,
+                format!("env_rotation {env_rotation}: give a finite angle in degrees"),
+            ));
+        }
         let options = LoadOptions {
             scene,
             environment,
             environment_map,
+            env_rotation,
+            no_environment,
             array_limit: None,
         };
         let (result, warnings) = without_gil(py, || {
