@@ -1,0 +1,157 @@
+// Light selection by likely contribution: a stochastic single-path descent of the light tree
+// (pbrt-v4 BVHLightSampler; Conty Estevez & Kulla 2018), built on the host (src/scene/light_tree.rs)
+// and stored in the emitter buffer right after the emitter rows: a header row (directional light
+// count, node count, 0, 0), then LIGHT_NODE_ROWS rows per node. Directional lights are
+// chosen beside the tree with fixed probabilities (light_groups). Expects `emitters` and the
+// scene parameters (scene_bindings.glsl). Twin: src/shading/light_tree.rs.
+#ifndef LIGHT_TREE_GLSL
+#define LIGHT_TREE_GLSL
+
+#include "loop_budget.glsl"
+#include "types.glsl"
+
+struct LightNode {
+    vec3 lo;
+    float intensity;   // sum of the largest radiant intensities below (luminance, W/sr)
+    vec3 hi;
+    float cos_theta_o; // the cone of normals around axis
+    vec3 axis;
+    float cos_theta_e; // how far beyond it the lights still emit
+    uint child;        // a leaf's emitter row; an interior node's second child (the first follows it)
+    uint flags;        // LIGHT_NODE_LEAF | LIGHT_NODE_TWO_SIDED
+};
+
+uvec4 emitter_words(uint row) {
+    Emitter e = emitters[row];
+    return uvec4(e.triangle, e.trail, floatBitsToUint(e.intensity), e.leaf);
+}
+
+uint light_tree_row(uint r) { return emitter_count + r; }
+
+LightNode light_node(uint i) {
+    uint base = light_tree_row(1u + LIGHT_NODE_ROWS * i);
+    uvec4 a = emitter_words(base);
+    uvec4 b = emitter_words(base + 1u);
+    uvec4 c = emitter_words(base + 2u);
+    uvec4 d = emitter_words(base + 3u);
+    LightNode n;
+    n.lo = uintBitsToFloat(a.xyz);
+    n.intensity = uintBitsToFloat(a.w);
+    n.hi = uintBitsToFloat(b.xyz);
+    n.cos_theta_o = uintBitsToFloat(b.w);
+    n.axis = uintBitsToFloat(c.xyz);
+    n.cos_theta_e = uintBitsToFloat(c.w);
+    n.child = d.x;
+    n.flags = d.y;
+    return n;
+}
+
+// The directional lights: the last rows before emitter_count.
+uint directional_count() { return emitters[light_tree_row(0u)].triangle; }
+
+// The first row after the tree: the punctual lights' parameters.
+uint light_tree_end() { return light_tree_row(1u + LIGHT_NODE_ROWS * emitters[light_tree_row(0u)].trail); }
+
+// The choices beside the environment, each with the same probability: every directional light,
+// and the tree when it holds a light.
+uint light_groups() { return directional_count() + (emitter_count > directional_count() ? 1u : 0u); }
+
+// pbrt-v4 LightBounds::Importance without a receiver normal: intensity · cos θ' / d², θ' the
+// smallest angle between the node's emission cone and the direction to p over the node's
+// bounding sphere, d clamped to that sphere's radius; 0 where no light below can reach p.
+// Twin: light_tree::light_node_importance.
+float light_node_importance(LightNode n, vec3 p) {
+    vec3 half_diag = 0.5 * (n.hi - n.lo);
+    float r2 = dot(half_diag, half_diag);
+    vec3 from_centre = p - 0.5 * (n.lo + n.hi);
+    float d2 = dot(from_centre, from_centre);
+    float d2_clamped = max(d2, r2);
+    if (!(d2_clamped > 0.0)) return 0.0;
+    float cos_w = d2 > 0.0 ? clamp(dot(n.axis, from_centre) / sqrt(d2), -1.0, 1.0) : 1.0;
+    if ((n.flags & LIGHT_NODE_TWO_SIDED) != 0u) cos_w = abs(cos_w);
+    float sin_w = sqrt(max(1.0 - cos_w * cos_w, 0.0));
+    float sin_o = sqrt(max(1.0 - n.cos_theta_o * n.cos_theta_o, 0.0));
+    // θ_x = max(0, θ_w - θ_o), then θ' = max(0, θ_x - θ_b) with θ_b the bounding sphere's
+    // half-angle seen from p (π inside it).
+    float cos_x = 1.0;
+    float sin_x = 0.0;
+    if (cos_w < n.cos_theta_o) {
+        cos_x = cos_w * n.cos_theta_o + sin_w * sin_o;
+        sin_x = sin_w * n.cos_theta_o - cos_w * sin_o;
+    }
+    float cos_p = 1.0;
+    if (d2 > r2) {
+        float sin_b2 = r2 / d2;
+        float cos_b = sqrt(max(1.0 - sin_b2, 0.0));
+        if (cos_x < cos_b) cos_p = cos_x * cos_b + sin_x * sqrt(sin_b2);
+    }
+    if (cos_p < n.cos_theta_e) return 0.0;
+    return n.intensity * max(cos_p, 0.0) / d2_clamped;
+}
+
+// Descends the tree from the root at p, at each node to a child with probability proportional
+// to its importance: by u in [0, 1) when sampling, else along the bit trail `trail` (bit d: the
+// second child at depth d). Returns the emitter row of the leaf reached (NO_EMITTER if no light
+// can reach p) and, in pmf, the product of the branch probabilities: sampling and following a
+// light's trail give the same pmf for the same p. Twin: light_tree::light_tree_walk.
+uint light_tree_walk(vec3 p, bool sampling, uint trail, float u, out float pmf) {
+    pmf = 1.0;
+    uint node = 0u;
+    uint depth = 0u;
+    for (; depth <= LIGHT_TREE_MAX_DEPTH; depth++) {
+        loop_tick();
+        LightNode n = light_node(node);
+        if ((n.flags & LIGHT_NODE_LEAF) != 0u) return n.child;
+        float first = light_node_importance(light_node(node + 1u), p);
+        float second = light_node_importance(light_node(n.child), p);
+        if (!(first + second > 0.0)) {
+            pmf = 0.0;
+            return NO_EMITTER;
+        }
+        float p_first = first / (first + second);
+        bool take_second = sampling ? u >= p_first : (trail & 1u) != 0u;
+        if (take_second) {
+            pmf *= 1.0 - p_first;
+            u = min((u - p_first) / (1.0 - p_first), 0.99999994);
+            node = n.child;
+        } else {
+            pmf *= p_first;
+            u = min(u / p_first, 0.99999994);
+            node = node + 1u;
+        }
+        trail >>= 1u;
+    }
+    // The tree is at most LIGHT_TREE_MAX_DEPTH deep: only the driver's loop budget ends here.
+    note_loop_exit(depth <= LIGHT_TREE_MAX_DEPTH);
+    pmf = 0.0;
+    return NO_EMITTER;
+}
+
+// Probability of choosing the environment rather than another light.
+float env_select_prob() { return scene_env.w; }
+
+// The probability that light sampling at p chooses the light of emitter row `row` (discrete; the
+// environment's share excluded): its group's, times its path's through the tree.
+// Twin: light_tree::light_select_pmf.
+float light_select_pmf(vec3 p, uint row) {
+    float pmf = 1.0;
+    if (row < emitter_count - directional_count()) light_tree_walk(p, false, emitters[row].trail, 0.0, pmf);
+    return pmf * ((1.0 - env_select_prob()) / float(light_groups()));
+}
+
+// The emitter row that light sampling at p draws with u in [0, 1), and its probability (as
+// light_select_pmf): a group by u, then, in the tree, a leaf by what is left of u. NO_EMITTER
+// and 0 when no light can reach p. Twin: light_tree::light_select.
+uint light_select(vec3 p, float u, out float pmf) {
+    uint groups = light_groups();
+    float scaled = u * float(groups);
+    uint group = min(uint(scaled), groups - 1u);
+    uint n_dir = directional_count();
+    uint row = emitter_count - n_dir + group;
+    pmf = 1.0;
+    if (group >= n_dir) row = light_tree_walk(p, true, 0u, min(scaled - float(group), 0.99999994), pmf);
+    pmf *= (1.0 - env_select_prob()) / float(groups);
+    return row;
+}
+
+#endif
