@@ -1,8 +1,8 @@
 // Light selection by likely contribution: a stochastic single-path descent of the light tree
 // (pbrt-v4 BVHLightSampler; Conty Estevez & Kulla 2018), built on the host (src/scene/light_tree.rs)
 // and stored in the emitter buffer right after the emitter rows: a header row (directional light
-// count, node count, 0, 0), then LIGHT_NODE_ROWS rows per node. Directional lights are
-// chosen beside the tree with fixed probabilities (light_groups). Expects `emitters` and the
+// count, node count, their summed irradiance, 0), then LIGHT_NODE_ROWS rows per node.
+// Directional lights are chosen beside the tree (light_select). Expects `emitters` and the
 // scene parameters (scene_bindings.glsl). Twin: src/shading/light_tree.rs.
 #ifndef LIGHT_TREE_GLSL
 #define LIGHT_TREE_GLSL
@@ -52,10 +52,6 @@ uint directional_count() { return emitters[light_tree_row(0u)].triangle; }
 // The first row after the tree: the punctual lights' parameters.
 uint light_tree_end() { return light_tree_row(1u + LIGHT_NODE_ROWS * emitters[light_tree_row(0u)].trail); }
 
-// The choices beside the environment, each with the same probability: every directional light,
-// and the tree when it holds a light.
-uint light_groups() { return directional_count() + (emitter_count > directional_count() ? 1u : 0u); }
-
 // pbrt-v4 LightBounds::Importance without a receiver normal: intensity · cos θ' / d², θ' the
 // smallest angle between the node's emission cone and the direction to p over the node's
 // bounding sphere, d clamped to that sphere's radius; 0 where no light below can reach p.
@@ -89,68 +85,130 @@ float light_node_importance(LightNode n, vec3 p) {
     return n.intensity * max(cos_p, 0.0) / d2_clamped;
 }
 
-// Descends the tree from the root at p, at each node to a child with probability proportional
-// to its importance: by u in [0, 1) when sampling, else along the bit trail `trail` (bit d: the
-// second child at depth d). Returns the emitter row of the leaf reached (NO_EMITTER if no light
-// can reach p) and, in pmf, the product of the branch probabilities: sampling and following a
-// light's trail give the same pmf for the same p. Twin: light_tree::light_tree_walk.
-uint light_tree_walk(vec3 p, bool sampling, uint trail, float u, out float pmf) {
-    pmf = 1.0;
+const uint WALK_SAMPLE = 0u;    // descend by u
+const uint WALK_TRAIL = 1u;     // descend along a light's bit trail
+const uint WALK_ESTIMATE = 2u;  // descend to the more important child, summing the others
+
+// Descends the tree from the root at p. WALK_SAMPLE and WALK_TRAIL go to a child with
+// probability proportional to its importance, by u in [0, 1) or along the bit trail `trail`
+// (bit d: the second child at depth d), and return in `value` the product of the branch
+// probabilities: sampling a light and following its trail give the same product for the same p.
+// WALK_ESTIMATE goes to the more important child and returns in `value` the importance of the
+// leaf reached plus that of every child passed by: a deterministic estimate of what the tree's
+// lights send to p, refined towards the one that sends most. Returns the emitter row of the leaf
+// reached (NO_EMITTER where no light below can reach p: then a probability of 0).
+// Twin: light_tree::light_tree_walk.
+uint light_tree_walk(vec3 p, uint mode, uint trail, float u, out float value) {
+    value = mode == WALK_ESTIMATE ? 0.0 : 1.0;
     uint node = 0u;
+    float reached = -1.0;  // the importance of `node`, once known
     uint depth = 0u;
     for (; depth <= LIGHT_TREE_MAX_DEPTH; depth++) {
         loop_tick();
         LightNode n = light_node(node);
-        if ((n.flags & LIGHT_NODE_LEAF) != 0u) return n.child;
+        if ((n.flags & LIGHT_NODE_LEAF) != 0u) {
+            if (mode == WALK_ESTIMATE) value += reached >= 0.0 ? reached : light_node_importance(n, p);
+            return n.child;
+        }
         float first = light_node_importance(light_node(node + 1u), p);
         float second = light_node_importance(light_node(n.child), p);
         if (!(first + second > 0.0)) {
-            pmf = 0.0;
+            // No light below reaches p: a dead end (the estimate keeps what it passed by).
+            if (mode != WALK_ESTIMATE) value = 0.0;
             return NO_EMITTER;
         }
         float p_first = first / (first + second);
-        bool take_second = sampling ? u >= p_first : (trail & 1u) != 0u;
+        bool take_second = mode == WALK_SAMPLE ? u >= p_first : mode == WALK_TRAIL ? (trail & 1u) != 0u : second > first;
+        if (mode == WALK_ESTIMATE) value += take_second ? first : second;
         if (take_second) {
-            pmf *= 1.0 - p_first;
+            if (mode != WALK_ESTIMATE) value *= 1.0 - p_first;
             u = min((u - p_first) / (1.0 - p_first), 0.99999994);
             node = n.child;
         } else {
-            pmf *= p_first;
+            if (mode != WALK_ESTIMATE) value *= p_first;
             u = min(u / p_first, 0.99999994);
             node = node + 1u;
         }
+        reached = take_second ? second : first;
         trail >>= 1u;
     }
     // The tree is at most LIGHT_TREE_MAX_DEPTH deep: only the driver's loop budget ends here.
     note_loop_exit(depth <= LIGHT_TREE_MAX_DEPTH);
-    pmf = 0.0;
+    value = 0.0;
     return NO_EMITTER;
 }
 
 // Probability of choosing the environment rather than another light.
 float env_select_prob() { return scene_env.w; }
 
-// The probability that light sampling at p chooses the light of emitter row `row` (discrete; the
-// environment's share excluded): its group's, times its path's through the tree.
+// The directional lights' summed irradiance (luminance), from the tree's header.
+float directional_total() { return uintBitsToFloat(emitter_words(light_tree_row(0u)).z); }
+
+// The probability of choosing the tree rather than a directional light at p (the environment's
+// share aside): the tree's WALK_ESTIMATE against the directional lights' irradiance, so that a
+// lamp where it outshines the sun is chosen as if the sun were not there, and the sun where it
+// outshines the lamps. Directional lights are then chosen in proportion to their irradiance.
+// One walk call in a loop of two passes keeps one copy of the walk in the kernel.
+// Both functions below return the emitter row chosen or given, and its probability with the
+// environment's share removed (1 - env_select_prob()).
+
+// The probability that light sampling at p chooses the light of emitter row `row` (discrete).
 // Twin: light_tree::light_select_pmf.
 float light_select_pmf(vec3 p, uint row) {
-    float pmf = 1.0;
-    if (row < emitter_count - directional_count()) light_tree_walk(p, false, emitters[row].trail, 0.0, pmf);
-    return pmf * ((1.0 - env_select_prob()) / float(light_groups()));
+    uint n_dir = directional_count();
+    bool has_tree = emitter_count > n_dir;
+    bool in_tree = row < emitter_count - n_dir;
+    float share = has_tree ? 1.0 : 0.0;
+    float walk = 1.0;
+    // Pass 0 (beside directional lights only) weighs the tree; pass 1 follows the light's trail.
+    for (uint pass = has_tree && n_dir > 0u ? 0u : 1u; pass < 2u; pass++) {
+        if (pass == 1u && !in_tree) break;
+        float value;
+        light_tree_walk(p, pass == 0u ? WALK_ESTIMATE : WALK_TRAIL, emitters[row].trail, 0.0, value);
+        if (pass == 0u) share = value / (value + directional_total());
+        else walk = value;
+    }
+    float pmf = in_tree ? share * walk : (1.0 - share) * (emitters[row].intensity / directional_total());
+    return pmf * (1.0 - env_select_prob());
 }
 
-// The emitter row that light sampling at p draws with u in [0, 1), and its probability (as
-// light_select_pmf): a group by u, then, in the tree, a leaf by what is left of u. NO_EMITTER
-// and 0 when no light can reach p. Twin: light_tree::light_select.
+// The emitter row that light sampling at p draws with u in [0, 1) (NO_EMITTER when no light can
+// reach p) and, in pmf, its probability as light_select_pmf gives it. Twin: light_tree::light_select.
 uint light_select(vec3 p, float u, out float pmf) {
-    uint groups = light_groups();
-    float scaled = u * float(groups);
-    uint group = min(uint(scaled), groups - 1u);
     uint n_dir = directional_count();
-    uint row = emitter_count - n_dir + group;
-    pmf = 1.0;
-    if (group >= n_dir) row = light_tree_walk(p, true, 0u, min(scaled - float(group), 0.99999994), pmf);
-    pmf *= (1.0 - env_select_prob()) / float(groups);
+    bool has_tree = emitter_count > n_dir;
+    float share = has_tree ? 1.0 : 0.0;
+    uint row = NO_EMITTER;
+    pmf = 0.0;
+    // Pass 0 (beside directional lights only) weighs the tree; pass 1 draws from it.
+    for (uint pass = has_tree && n_dir > 0u ? 0u : 1u; pass < 2u; pass++) {
+        if (pass == 1u && !(u < share)) break;
+        float value;
+        uint r = light_tree_walk(p, pass == 0u ? WALK_ESTIMATE : WALK_SAMPLE, 0u, min(u / share, 0.99999994), value);
+        if (pass == 0u) {
+            share = value / (value + directional_total());
+        } else {
+            row = r;
+            pmf = share * value;
+        }
+    }
+    if (!(u < share)) {
+        // A directional light, by irradiance: the first whose running sum passes the target.
+        float total = directional_total();
+        float target = (u - share) / (1.0 - share) * total;
+        float sum = 0.0;
+        row = emitter_count - 1u;
+        for (uint i = emitter_count - n_dir; i < emitter_count; i++) {
+            loop_tick();
+            sum += emitters[i].intensity;
+            if (target < sum) {
+                row = i;
+                break;
+            }
+        }
+        pmf = (1.0 - share) * (emitters[row].intensity / total);
+    }
+    pmf *= 1.0 - env_select_prob();
     return row;
 }
 

@@ -62,7 +62,8 @@ pub struct Scene {
     /// The light tree over the emitters before the directional ones (src/scene/light_tree.rs);
     /// empty when there are none.
     pub light_nodes: Vec<LightNode>,
-    /// Directional lights: the last rows of `emitters`, each chosen as often as the light tree.
+    /// Directional lights: the last rows of `emitters`, chosen beside the light tree
+    /// (`shading::light_tree::light_select`).
     pub directional_count: u32,
     /// Per punctual light (index into `lights`): its row in `emitters`.
     pub punctual_emitter_rows: Vec<u32>,
@@ -251,9 +252,10 @@ impl Scene {
     }
 
     /// The emitter-buffer rows of the light tree (glsl/light_tree.glsl): a header (directional
-    /// lights, nodes, 0, 0), then [`crate::gpu_types::LIGHT_NODE_ROWS`] rows per node.
+    /// lights, nodes, their summed irradiance, 0), then [`crate::gpu_types::LIGHT_NODE_ROWS`] rows per node.
     pub fn light_tree_rows(&self) -> Vec<Emitter> {
-        let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, 0, 0]);
+        let total = crate::shading::light_tree::directional_total(self);
+        let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, total.to_bits(), 0]);
         std::iter::once(header)
             .chain(self.light_nodes.iter().flat_map(|n| n.rows()))
             .collect()

@@ -165,7 +165,8 @@ fn light_selection_chi_square_follows_its_pmf() {
         }
         let mut pmf: Vec<f64> = (0..n as u32).map(|row| light_select_pmf(&scene, p, row) as f64 / keep).collect();
         let total: f64 = pmf.iter().sum();
-        assert!(total < 1.0 + 1e-4 && total > 0.5, "light_select_pmf sums to {total} at {p}");
+        assert!(total < 1.0 + 1e-4 && total > 0.3, "light_select_pmf sums to {total} at {p}");
+        eprintln!("light selection at {p}: the pmf sums to {total:.4} (the rest: dead ends)");
         pmf.push((1.0 - total).max(0.0));
         let expected: Vec<f64> = pmf.iter().map(|q| q * (SAMPLES / 2) as f64).collect();
         assert_fits(&format!("light selection at {p}"), &observed, &expected);
