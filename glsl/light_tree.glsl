@@ -1,7 +1,7 @@
 // Light selection by likely contribution: a stochastic single-path descent of the light tree
 // (pbrt-v4 BVHLightSampler; Conty Estevez & Kulla 2018), built on the host (src/scene/light_tree.rs)
 // and stored in the emitter buffer right after the emitter rows: a header row (directional light
-// count, node count, their summed irradiance, 0), then LIGHT_NODE_ROWS rows per node.
+// count, node count, 0, 0), then LIGHT_NODE_ROWS rows per node.
 // Directional lights are chosen beside the tree (light_select). Expects `emitters` and the
 // scene parameters (scene_bindings.glsl). Twin: src/shading/light_tree.rs.
 #ifndef LIGHT_TREE_GLSL
@@ -52,11 +52,12 @@ uint directional_count() { return emitters[light_tree_row(0u)].triangle; }
 // The first row after the tree: the punctual lights' parameters.
 uint light_tree_end() { return light_tree_row(1u + LIGHT_NODE_ROWS * emitters[light_tree_row(0u)].trail); }
 
-// pbrt-v4 LightBounds::Importance without a receiver normal: intensity · cos θ' / d², θ' the
-// smallest angle between the node's emission cone and the direction to p over the node's
-// bounding sphere, d clamped to that sphere's radius; 0 where no light below can reach p.
-// Twin: light_tree::light_node_importance.
-float light_node_importance(LightNode n, vec3 p) {
+// pbrt-v4 LightBounds::Importance: intensity · cos θ' · |cos θ_i'| / d² at p with normal `normal`
+// (unit), θ' the smallest angle between the node's emission cone and the direction to p over the
+// node's bounding sphere, θ_i' the smallest angle between ±normal and the directions to that
+// sphere (|cos|: a surface may transmit), d clamped to the sphere's radius; 0 where no light
+// below can reach p. Twin: light_tree::light_node_importance.
+float light_node_importance(LightNode n, vec3 p, vec3 normal) {
     vec3 half_diag = 0.5 * (n.hi - n.lo);
     float r2 = dot(half_diag, half_diag);
     vec3 from_centre = p - 0.5 * (n.lo + n.hi);
@@ -76,13 +77,17 @@ float light_node_importance(LightNode n, vec3 p) {
         sin_x = sin_w * n.cos_theta_o - cos_w * sin_o;
     }
     float cos_p = 1.0;
+    float cos_i = 1.0;
     if (d2 > r2) {
         float sin_b2 = r2 / d2;
         float cos_b = sqrt(max(1.0 - sin_b2, 0.0));
-        if (cos_x < cos_b) cos_p = cos_x * cos_b + sin_x * sqrt(sin_b2);
+        float sin_b = sqrt(sin_b2);
+        if (cos_x < cos_b) cos_p = cos_x * cos_b + sin_x * sin_b;
+        float cos_n = min(abs(dot(normal, from_centre)) / sqrt(d2), 1.0);
+        if (cos_n < cos_b) cos_i = cos_n * cos_b + sqrt(max(1.0 - cos_n * cos_n, 0.0)) * sin_b;
     }
     if (cos_p < n.cos_theta_e) return 0.0;
-    return n.intensity * max(cos_p, 0.0) / d2_clamped;
+    return n.intensity * max(cos_p, 0.0) * cos_i / d2_clamped;
 }
 
 const uint WALK_SAMPLE = 0u;    // descend by u
@@ -98,7 +103,7 @@ const uint WALK_ESTIMATE = 2u;  // descend to the more important child, summing 
 // lights send to p, refined towards the one that sends most. Returns the emitter row of the leaf
 // reached (NO_EMITTER where no light below can reach p: then a probability of 0).
 // Twin: light_tree::light_tree_walk.
-uint light_tree_walk(vec3 p, uint mode, uint trail, float u, out float value) {
+uint light_tree_walk(vec3 p, vec3 normal, uint mode, uint trail, float u, out float value) {
     value = mode == WALK_ESTIMATE ? 0.0 : 1.0;
     uint node = 0u;
     float reached = -1.0;  // the importance of `node`, once known
@@ -107,11 +112,11 @@ uint light_tree_walk(vec3 p, uint mode, uint trail, float u, out float value) {
         loop_tick();
         LightNode n = light_node(node);
         if ((n.flags & LIGHT_NODE_LEAF) != 0u) {
-            if (mode == WALK_ESTIMATE) value += reached >= 0.0 ? reached : light_node_importance(n, p);
+            if (mode == WALK_ESTIMATE) value += reached >= 0.0 ? reached : light_node_importance(n, p, normal);
             return n.child;
         }
-        float first = light_node_importance(light_node(node + 1u), p);
-        float second = light_node_importance(light_node(n.child), p);
+        float first = light_node_importance(light_node(node + 1u), p, normal);
+        float second = light_node_importance(light_node(n.child), p, normal);
         if (!(first + second > 0.0)) {
             // No light below reaches p: a dead end (the estimate keeps what it passed by).
             if (mode != WALK_ESTIMATE) value = 0.0;
@@ -141,42 +146,72 @@ uint light_tree_walk(vec3 p, uint mode, uint trail, float u, out float value) {
 // Probability of choosing the environment rather than another light.
 float env_select_prob() { return scene_env.w; }
 
-// The directional lights' summed irradiance (luminance), from the tree's header.
-float directional_total() { return uintBitsToFloat(emitter_words(light_tree_row(0u)).z); }
+// A unit direction from its octahedral encoding (two 16-bit fixed-point coordinates).
+// Twin: light_tree::octahedral_decode.
+vec3 octahedral_decode(uint bits) {
+    vec2 f = vec2(float(bits & 0xffffu), float(bits >> 16u)) * (2.0 / 65535.0) - 1.0;
+    vec3 v = vec3(f, 1.0 - abs(f.x) - abs(f.y));
+    float t = max(-v.z, 0.0);
+    v.x += v.x >= 0.0 ? -t : t;
+    v.y += v.y >= 0.0 ? -t : t;
+    return normalize(v);
+}
+
+// What directional light `row` sends to a surface of normal `normal`, for choosing: E |cos θ|,
+// the cosine floored at 1e-3 so that no light is ever left out (shading normals may tilt).
+// Twin: light_tree::directional_weight.
+float directional_weight(uint row, vec3 normal) {
+    Emitter e = emitters[row];
+    return e.intensity * max(abs(dot(normal, octahedral_decode(e.trail))), 1e-3);
+}
+
+// The directional lights' summed weights at a surface of normal `normal`.
+float directional_total(vec3 normal) {
+    float total = 0.0;
+    for (uint i = emitter_count - directional_count(); i < emitter_count; i++) {
+        loop_tick();
+        total += directional_weight(i, normal);
+    }
+    return total;
+}
 
 // The probability of choosing the tree rather than a directional light at p (the environment's
-// share aside): the tree's WALK_ESTIMATE against the directional lights' irradiance, so that a
-// lamp where it outshines the sun is chosen as if the sun were not there, and the sun where it
-// outshines the lamps. Directional lights are then chosen in proportion to their irradiance.
-// One walk call in a loop of two passes keeps one copy of the walk in the kernel.
-// Both functions below return the emitter row chosen or given, and its probability with the
-// environment's share removed (1 - env_select_prob()).
+// share aside): the tree's WALK_ESTIMATE against the directional lights' weights, so that a lamp
+// where it outshines the sun is chosen as if the sun were not there, and the sun where it
+// outshines the lamps. Directional lights are then chosen in proportion to their weights.
+float tree_share(float estimate, float total) { return estimate > 0.0 ? estimate / (estimate + total) : 0.0; }
+
+// Both functions below return (or take) an emitter row and its probability at p with normal
+// `normal`, the environment's share removed (1 - env_select_prob()). One walk call in a loop of
+// two passes keeps one copy of the walk in each.
 
 // The probability that light sampling at p chooses the light of emitter row `row` (discrete).
 // Twin: light_tree::light_select_pmf.
-float light_select_pmf(vec3 p, uint row) {
+float light_select_pmf(vec3 p, vec3 normal, uint row) {
     uint n_dir = directional_count();
     bool has_tree = emitter_count > n_dir;
     bool in_tree = row < emitter_count - n_dir;
+    float total = n_dir > 0u ? directional_total(normal) : 0.0;
     float share = has_tree ? 1.0 : 0.0;
     float walk = 1.0;
     // Pass 0 (beside directional lights only) weighs the tree; pass 1 follows the light's trail.
     for (uint pass = has_tree && n_dir > 0u ? 0u : 1u; pass < 2u; pass++) {
         if (pass == 1u && !in_tree) break;
         float value;
-        light_tree_walk(p, pass == 0u ? WALK_ESTIMATE : WALK_TRAIL, emitters[row].trail, 0.0, value);
-        if (pass == 0u) share = value / (value + directional_total());
+        light_tree_walk(p, normal, pass == 0u ? WALK_ESTIMATE : WALK_TRAIL, emitters[row].trail, 0.0, value);
+        if (pass == 0u) share = tree_share(value, total);
         else walk = value;
     }
-    float pmf = in_tree ? share * walk : (1.0 - share) * (emitters[row].intensity / directional_total());
+    float pmf = in_tree ? share * walk : (1.0 - share) * (directional_weight(row, normal) / total);
     return pmf * (1.0 - env_select_prob());
 }
 
 // The emitter row that light sampling at p draws with u in [0, 1) (NO_EMITTER when no light can
 // reach p) and, in pmf, its probability as light_select_pmf gives it. Twin: light_tree::light_select.
-uint light_select(vec3 p, float u, out float pmf) {
+uint light_select(vec3 p, vec3 normal, float u, out float pmf) {
     uint n_dir = directional_count();
     bool has_tree = emitter_count > n_dir;
+    float total = n_dir > 0u ? directional_total(normal) : 0.0;
     float share = has_tree ? 1.0 : 0.0;
     uint row = NO_EMITTER;
     pmf = 0.0;
@@ -184,29 +219,28 @@ uint light_select(vec3 p, float u, out float pmf) {
     for (uint pass = has_tree && n_dir > 0u ? 0u : 1u; pass < 2u; pass++) {
         if (pass == 1u && !(u < share)) break;
         float value;
-        uint r = light_tree_walk(p, pass == 0u ? WALK_ESTIMATE : WALK_SAMPLE, 0u, min(u / share, 0.99999994), value);
+        uint r = light_tree_walk(p, normal, pass == 0u ? WALK_ESTIMATE : WALK_SAMPLE, 0u, min(u / share, 0.99999994), value);
         if (pass == 0u) {
-            share = value / (value + directional_total());
+            share = tree_share(value, total);
         } else {
             row = r;
             pmf = share * value;
         }
     }
-    if (!(u < share)) {
-        // A directional light, by irradiance: the first whose running sum passes the target.
-        float total = directional_total();
+    if (!(u < share) && n_dir > 0u) {
+        // A directional light by weight: the first whose running sum passes the target.
         float target = (u - share) / (1.0 - share) * total;
         float sum = 0.0;
         row = emitter_count - 1u;
         for (uint i = emitter_count - n_dir; i < emitter_count; i++) {
             loop_tick();
-            sum += emitters[i].intensity;
+            sum += directional_weight(i, normal);
             if (target < sum) {
                 row = i;
                 break;
             }
         }
-        pmf = (1.0 - share) * (emitters[row].intensity / total);
+        pmf = (1.0 - share) * (directional_weight(row, normal) / total);
     }
     pmf *= 1.0 - env_select_prob();
     return row;

@@ -117,11 +117,11 @@ float emitter_area_pdf(float pmf, uint tri_index, vec3 dir, float dist) {
     return p_area * dist * dist / cos_l;
 }
 
-// Solid-angle pdf that NEE at p would have sampled direction `dir` hitting emitter triangle
-// `tri_index` at distance `dist` (used for MIS when BSDF sampling hits an emitter).
-float emitter_pdf(vec3 p, uint tri_index, vec3 dir, float dist) {
+// Solid-angle pdf that NEE at p (geometric normal n) would have sampled direction `dir` hitting
+// emitter triangle `tri_index` at distance `dist` (used for MIS when BSDF sampling hits an emitter).
+float emitter_pdf(vec3 p, vec3 n, uint tri_index, vec3 dir, float dist) {
     uint row = triangles[tri_index].emitter;
-    return row == NO_EMITTER ? 0.0 : emitter_area_pdf(light_select_pmf(p, row), tri_index, dir, dist);
+    return row == NO_EMITTER ? 0.0 : emitter_area_pdf(light_select_pmf(p, n, row), tri_index, dir, dist);
 }
 
 // u = 0.5 + atan2(d.x, -d.z) / 2pi (the centre column looks along -Z), v = acos(d.y) / pi (top +Y).
@@ -213,8 +213,9 @@ vec3 sample_environment(vec2 u) {
 // The emitter row of punctual light k (its fourth row holds it).
 uint punctual_emitter_row(uint k) { return emitters[light_tree_end() + PUNCTUAL_ROWS * k + 3u].triangle; }
 
-// u.x selects the light, u.yz the point or direction.
-LightSample sample_light(vec3 p, vec3 u) {
+// A light sample from p (geometric normal n, unit, which weighs the lights): u.x selects the
+// environment or a light (light_select), u.yz the point or direction.
+LightSample sample_light(vec3 p, vec3 n, vec3 u) {
     LightSample ls;
     ls.dir = vec3(0.0, 0.0, 1.0);
     ls.dist = 0.0;
@@ -232,7 +233,7 @@ LightSample sample_light(vec3 p, vec3 u) {
     if (SCENE_EMITTERS == 0 || emitter_count == 0u) return ls;
     float u_select = (u.x - p_env) / (1.0 - p_env);
     float pmf;
-    uint row = light_select(p, min(u_select, 0.99999994), pmf);
+    uint row = light_select(p, n, min(u_select, 0.99999994), pmf);
     if (row == NO_EMITTER) return ls;
     Emitter e = emitters[row];
 #if SCENE_PUNCTUAL

@@ -143,7 +143,7 @@ float light_pdf(Vertex from, Vertex end) {
     bool punctual = vertex_is_punctual(end);
     uint row = punctual ? punctual_emitter_row(vertex_light(end)) : triangles[end.triangle].emitter;
     if (row == NO_EMITTER) return 0.0;
-    float pmf = light_select_pmf(from.pos, row);
+    float pmf = light_select_pmf(from.pos, from.normal, row);
     return punctual ? pmf : emitter_area_pdf(pmf, end.triangle, dir, dist);
 }
 

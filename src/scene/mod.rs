@@ -15,6 +15,7 @@ mod gltf_texture;
 pub mod gltf_writer;
 mod hit_surface;
 pub mod light_tree;
+pub mod many_lights_scene;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
@@ -180,7 +181,7 @@ fn light_table(mut ids: Vec<u32>, mut bounds: Vec<LightBounds>, lights: &[Punctu
         rows[k] = emitters.len() as u32;
         emitters.push(Emitter {
             triangle: PUNCTUAL_LIGHT_BIT | k as u32,
-            trail: 0,
+            trail: crate::shading::light_tree::octahedral_encode(light.direction),
             intensity: luminance(light.intensity),
             leaf: NO_EMITTER,
         });
@@ -252,10 +253,9 @@ impl Scene {
     }
 
     /// The emitter-buffer rows of the light tree (glsl/light_tree.glsl): a header (directional
-    /// lights, nodes, their summed irradiance, 0), then [`crate::gpu_types::LIGHT_NODE_ROWS`] rows per node.
+    /// lights, nodes, 0, 0), then [`crate::gpu_types::LIGHT_NODE_ROWS`] rows per node.
     pub fn light_tree_rows(&self) -> Vec<Emitter> {
-        let total = crate::shading::light_tree::directional_total(self);
-        let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, total.to_bits(), 0]);
+        let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, 0, 0]);
         std::iter::once(header)
             .chain(self.light_nodes.iter().flat_map(|n| n.rows()))
             .collect()

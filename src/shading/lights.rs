@@ -117,15 +117,16 @@ pub fn emitter_area_pdf(scene: &Scene, pmf: f32, tri_index: u32, dir: Vec3, dist
     p_area * dist * dist / cos_l
 }
 
-/// Solid-angle density (1/sr) with which [`sample_light`] at `p` picks the point at distance
-/// `dist` along unit `dir` on emissive triangle `tri_index` (see [`emitter_area_pdf`] and
-/// [`light_select_pmf`]); 0 for a triangle that does not emit. Twin of GLSL `emitter_pdf`.
-pub fn emitter_pdf(scene: &Scene, p: Vec3, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
+/// Solid-angle density (1/sr) with which [`sample_light`] at `p` (geometric normal `n`) picks
+/// the point at distance `dist` along unit `dir` on emissive triangle `tri_index` (see
+/// [`emitter_area_pdf`] and [`light_select_pmf`]); 0 for a triangle that does not emit. Twin
+/// of GLSL `emitter_pdf`.
+pub fn emitter_pdf(scene: &Scene, p: Vec3, n: Vec3, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
     let row = scene.triangles[tri_index as usize].emitter;
     if row == NO_EMITTER {
         0.0
     } else {
-        emitter_area_pdf(scene, light_select_pmf(scene, p, row), tri_index, dir, dist)
+        emitter_area_pdf(scene, light_select_pmf(scene, p, n, row), tri_index, dir, dist)
     }
 }
 
@@ -149,9 +150,10 @@ pub fn environment_radiance(scene: &Scene, dir: Vec3) -> Vec3 {
     }
 }
 
-/// A light sample from `p`: u.x selects the environment or a light (by [`light_select`]), u.yz
-/// the point or direction. Twin of GLSL `sample_light`.
-pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
+/// A light sample from `p` (geometric normal `n`, unit, which weighs the lights): u.x selects
+/// the environment or a light (by [`light_select`]), u.yz the point or direction. Twin of GLSL
+/// `sample_light`.
+pub fn sample_light(scene: &Scene, p: Vec3, n: Vec3, u: Vec3) -> LightSample {
     let none = LightSample {
         dir: Vec3::Z,
         dist: 0.0,
@@ -177,7 +179,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
         return none;
     }
     let u_select = (u.x - p_env) / (1.0 - p_env);
-    let (row, pmf) = light_select(scene, p, u_select.min(0.99999994));
+    let (row, pmf) = light_select(scene, p, n, u_select.min(0.99999994));
     if row == NO_EMITTER {
         return none;
     }

@@ -261,7 +261,7 @@ fn check_traversal(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize, coverage
 /// sample_light, camera_ray_dir and punctual_occluded of item `i` against their Rust twins.
 fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
     let (o, d, u, px) = (input[0], input[1].truncate(), input[2].truncate(), input[3]);
-    let ls = sample_light(scene, o.truncate(), u);
+    let ls = sample_light(scene, o.truncate(), d, u);
     let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
     assert!(
         dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
@@ -364,7 +364,7 @@ fn environment_map_light_sampling_glsl_matches_rust() {
     let (mut env_samples, mut near_edges) = (0, 0);
     for i in 0..RAYS {
         let (o, u) = (inputs[4 * i].truncate(), inputs[4 * i + 2].truncate());
-        let ls = sample_light(&scene, o, u);
+        let ls = sample_light(&scene, o, inputs[4 * i + 1].truncate(), u);
         let g = &out[6 * i..6 * i + 6];
         assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light choice, item {i}");
         assert!(

@@ -19,6 +19,7 @@ mod gris;
 mod gris_oracle;
 mod independent_renderer;
 mod layout;
+mod many_lights;
 mod normal_mapped_scene;
 mod punctual;
 mod ray_offset;

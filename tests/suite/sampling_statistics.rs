@@ -155,15 +155,21 @@ fn light_selection_chi_square_follows_its_pmf() {
     let n = scene.emitters.len();
     let keep = 1.0 - scene.env_select_prob as f64;
     let mut r = TestRng(61);
-    for p in [Vec3::new(0.3, -0.2, 0.1), Vec3::new(-4.0, 4.5, 2.0), Vec3::new(6.0, 0.0, -6.0)] {
+    for (p, normal) in [
+        (Vec3::new(0.3, -0.2, 0.1), Vec3::Y),
+        (Vec3::new(-4.0, 4.5, 2.0), Vec3::new(0.6, 0.0, 0.8)),
+        (Vec3::new(6.0, 0.0, -6.0), -Vec3::X),
+    ] {
         // The last bin: descents that end where no child can reach p (pbrt-v4 fails them too).
         let mut observed = vec![0.0; n + 1];
         for _ in 0..SAMPLES / 2 {
-            let (row, pmf) = light_select(&scene, p, r.uniform());
+            let (row, pmf) = light_select(&scene, p, normal, r.uniform());
             assert_eq!(row == NO_EMITTER, pmf == 0.0, "a light drawn with probability 0 at {p}");
             observed[(row as usize).min(n)] += 1.0;
         }
-        let mut pmf: Vec<f64> = (0..n as u32).map(|row| light_select_pmf(&scene, p, row) as f64 / keep).collect();
+        let mut pmf: Vec<f64> = (0..n as u32)
+            .map(|row| light_select_pmf(&scene, p, normal, row) as f64 / keep)
+            .collect();
         let total: f64 = pmf.iter().sum();
         assert!(total < 1.0 + 1e-4 && total > 0.3, "light_select_pmf sums to {total} at {p}");
         eprintln!("light selection at {p}: the pmf sums to {total:.4} (the rest: dead ends)");
@@ -185,7 +191,7 @@ fn sample_light_pdf_is_consistent_with_solid_angle() {
     let n = 400_000;
     let light: Vec<f64> = (0..n)
         .map(|_| {
-            let ls = sample_light(&scene, p, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
+            let ls = sample_light(&scene, p, Vec3::Y, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
             if ls.pdf > 0.0 {
                 1.0 / ls.pdf as f64
             } else {
@@ -195,7 +201,7 @@ fn sample_light_pdf_is_consistent_with_solid_angle() {
         .collect();
     // Light sampling reaches every emitter whose selection probability at p is positive.
     let emitters: Vec<_> = (0..scene.emitters.len() as u32)
-        .filter(|&row| restir_pt::shading::light_tree::light_select_pmf(&scene, p, row) > 0.0)
+        .filter(|&row| restir_pt::shading::light_tree::light_select_pmf(&scene, p, Vec3::Y, row) > 0.0)
         .map(|row| scene.triangles[scene.emitters[row as usize].triangle as usize])
         .collect();
     assert!(emitters.len() > 20, "{} emitters reachable", emitters.len());

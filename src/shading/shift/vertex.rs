@@ -209,7 +209,7 @@ pub(super) fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
     if row == NO_EMITTER {
         return 0.0;
     }
-    let pmf = light_select_pmf(scene, from.pos, row);
+    let pmf = light_select_pmf(scene, from.pos, from.normal, row);
     if punctual {
         pmf
     } else {
