@@ -152,7 +152,7 @@ const BUCKETS: usize = 12;
 impl LightTree {
     /// Builds the tree over `lights` (light i becomes the leaf whose `child` is i), splitting
     /// each group where the summed [`LightBounds`] cost of the two halves is least, over
-    /// [`BUCKETS`] centroid buckets on each axis. At most [`LIGHT_TREE_MAX_DEPTH`] deep: near
+    /// 12 centroid buckets on each axis. At most [`LIGHT_TREE_MAX_DEPTH`] deep: near
     /// that depth groups are halved in centroid order.
     pub fn build(lights: &[LightBounds]) -> Self {
         let mut tree = Self {

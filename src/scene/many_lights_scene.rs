@@ -6,8 +6,8 @@ use serde_json::json;
 
 use crate::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
-/// Lamps along each side of the grid (LAMP_GRID² in all; every fifth a point light, the rest
-/// emissive panels).
+/// Lamps along each side of the grid (LAMP_GRID² in all: one in five, on diagonals, a point
+/// light, the rest emissive panels).
 pub const LAMP_GRID: usize = 10;
 /// Side of an emissive lamp panel (scene units).
 pub const LAMP_SIDE: f32 = 0.15;
@@ -50,7 +50,7 @@ pub fn many_lights() -> String {
         let x = -9.0 + 2.0 * gx + 1.2 * (jitter(i, 1) - 0.5);
         let z = -9.0 + 2.0 * gz + 1.2 * (jitter(i, 2) - 0.5);
         let y = 0.5 + 0.8 * jitter(i, 3);
-        if (i % LAMP_GRID + 2 * (i / LAMP_GRID)) % 5 == 0 {
+        if (i % LAMP_GRID + 2 * (i / LAMP_GRID)).is_multiple_of(5) {
             let colour = [1.0, 0.75 + 0.2 * jitter(i, 4), 0.5 + 0.3 * jitter(i, 5)];
             b.punctual_light(
                 json!({ "type": "point", "color": colour, "intensity": 0.6 }),
