@@ -179,6 +179,58 @@ fn light_selection_chi_square_follows_its_pmf() {
     }
 }
 
+/// The pmf light sampling draws a light with equals the one `light_select_pmf` recomputes along
+/// the light's bit trail, bit for bit (the shifts and MIS rely on it), and `sample_light`'s pdf
+/// equals `emitter_pdf`'s (or, for a punctual light, `light_select_pmf`'s) to float rounding,
+/// at 2×10^5 random shading points, normals and uniforms of the scene with every kind of light
+/// (measured: 180363 lights drawn, 38523 samples on triangles).
+#[test]
+fn light_select_pmf_recomputes_the_sampled_pmf_exactly() {
+    use restir_pt::shading::light_tree::{light_select, light_select_pmf};
+    use restir_pt::shading::lights::{emitter_pdf, is_punctual_light, punctual_emitter_row};
+    let scene = crate::bvh_oracle::random_scene_with_punctual_lights(14);
+    let mut r = TestRng(81);
+    let (mut drawn, mut triangles) = (0, 0);
+    for i in 0..200_000 {
+        let p = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 12.0 - 6.0;
+        let n = r.unit_vector();
+        let (row, pmf) = light_select(&scene, p, n, r.uniform());
+        if row == NO_EMITTER {
+            continue;
+        }
+        drawn += 1;
+        assert_eq!(
+            light_select_pmf(&scene, p, n, row).to_bits(),
+            pmf.to_bits(),
+            "draw {i}: row {row} at {p}"
+        );
+        let ls = sample_light(&scene, p, n, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
+        if !(ls.pdf > 0.0) || ls.triangle == NO_EMITTER {
+            continue;
+        }
+        let again = if is_punctual_light(ls.triangle) {
+            light_select_pmf(
+                &scene,
+                p,
+                n,
+                punctual_emitter_row(&scene, ls.triangle & !restir_pt::gpu_types::PUNCTUAL_LIGHT_BIT),
+            )
+        } else {
+            triangles += 1;
+            emitter_pdf(&scene, p, n, ls.triangle, ls.dir, ls.dist)
+        };
+        assert!(
+            (again - ls.pdf).abs() <= 1e-5 * ls.pdf,
+            "sample {i}: pdf {} recomputed as {again}",
+            ls.pdf
+        );
+    }
+    assert!(
+        drawn > 150_000 && triangles > 30_000,
+        "{drawn} lights drawn, {triangles} triangle samples"
+    );
+}
+
 /// E[1 / pdf] over light samples equals the total solid angle the emitters subtend (each
 /// counted once per emitter), which uniform sphere sampling estimates independently.
 #[test]
