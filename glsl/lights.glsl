@@ -1,11 +1,13 @@
-// Next-event estimation: emissive triangles and punctual lights chosen by power through an alias
-// table, uniform area sampling, and a constant environment sampled uniformly over the sphere. A
+// Next-event estimation: emissive triangles and punctual lights chosen by their likely
+// contribution at the shading point through the light tree (light_tree.glsl), uniform area
+// sampling, and the environment beside them with a fixed probability. A
 // punctual light's sample is a delta: pdf is the discrete probability of choosing it, radiance
 // is I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
 // `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: src/shading/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
 
+#include "light_tree.glsl"
 #include "sampling.glsl"
 #include "texture.glsl"
 #include "types.glsl"
@@ -22,7 +24,8 @@
 #define SCENE_PUNCTUAL 1
 #endif
 // An equirectangular environment map (src/scene/environment.rs) replaces the constant environment; its
-// rows start SCENE_ENV_MAP_BASE rows after the alias table in the emitter buffer.
+// rows start SCENE_ENV_MAP_BASE rows after the emitter rows in the emitter buffer (after the light
+// tree and the punctual lights).
 #ifndef SCENE_ENV_MAP
 #define SCENE_ENV_MAP 0
 #endif
@@ -48,23 +51,20 @@ struct PunctualLight {
     float cos_outer;
     vec3 intensity;    // colour x intensity: candela (point, spot) or lux (directional)
     float cos_inner;
-    float select_pdf;
 };
 
-Emitter punctual_row(uint k, uint row) { return emitters[emitter_count + PUNCTUAL_ROWS * k + row]; }
-
 PunctualLight punctual_light(uint k) {
-    Emitter r0 = punctual_row(k, 0u);
-    Emitter r1 = punctual_row(k, 1u);
-    Emitter r2 = punctual_row(k, 2u);
+    uint base = light_tree_end() + PUNCTUAL_ROWS * k;
+    uvec4 r0 = emitter_words(base);
+    uvec4 r1 = emitter_words(base + 1u);
+    uvec4 r2 = emitter_words(base + 2u);
     PunctualLight l;
-    l.position = vec3(uintBitsToFloat(r0.triangle), r0.select_pdf, r0.alias_prob);
-    l.kind = r0.alias;
-    l.direction = vec3(uintBitsToFloat(r1.triangle), r1.select_pdf, r1.alias_prob);
-    l.cos_outer = uintBitsToFloat(r1.alias);
-    l.intensity = vec3(uintBitsToFloat(r2.triangle), r2.select_pdf, r2.alias_prob);
-    l.cos_inner = uintBitsToFloat(r2.alias);
-    l.select_pdf = uintBitsToFloat(punctual_row(k, 3u).triangle);
+    l.position = uintBitsToFloat(r0.xyz);
+    l.kind = r0.w;
+    l.direction = uintBitsToFloat(r1.xyz);
+    l.cos_outer = uintBitsToFloat(r1.w);
+    l.intensity = uintBitsToFloat(r2.xyz);
+    l.cos_inner = uintBitsToFloat(r2.w);
     return l;
 }
 
@@ -105,27 +105,23 @@ vec3 emitted_radiance(uint triangle, vec2 bary, vec3 to_viewer) {
     return lit ? m.emission : vec3(0.0);
 }
 
-uint alias_select(float u, uint count) {
-    float scaled = u * float(count);
-    uint i = min(uint(scaled), count - 1u);
-    float coin = scaled - float(i);
-    return coin < emitters[i].alias_prob ? i : emitters[i].alias;
-}
-
-// Probability of choosing the environment rather than an emitter.
-float env_select_prob() { return scene_env.w; }
-
-// Solid-angle pdf that NEE would have sampled direction `dir` hitting emitter triangle `tri_index`
-// at distance `dist` (used for MIS when BSDF sampling hits an emitter).
-float emitter_pdf(uint tri_index, vec3 dir, float dist) {
+// The solid-angle pdf of the point at distance `dist` along `dir` on emitter triangle `tri_index`
+// chosen with probability `pmf` and sampled uniformly by area.
+float emitter_area_pdf(float pmf, uint tri_index, vec3 dir, float dist) {
     Triangle tri = triangles[tri_index];
-    if (tri.emitter == NO_EMITTER) return 0.0;
     vec3 ng = cross(tri.e1, tri.e2);
     float area2 = length(ng);
     float cos_l = abs(dot(ng, dir)) / area2;
     if (cos_l <= 0.0) return 0.0;
-    float p_area = (1.0 - env_select_prob()) * emitters[tri.emitter].select_pdf * 2.0 / area2;
+    float p_area = pmf * 2.0 / area2;
     return p_area * dist * dist / cos_l;
+}
+
+// Solid-angle pdf that NEE at p (geometric normal n) would have sampled direction `dir` hitting
+// emitter triangle `tri_index` at distance `dist` (used for MIS when BSDF sampling hits an emitter).
+float emitter_pdf(vec3 p, vec3 n, uint tri_index, vec3 dir, float dist) {
+    uint row = triangles[tri_index].emitter;
+    return row == NO_EMITTER ? 0.0 : emitter_area_pdf(light_select_pmf(p, n, row), tri_index, dir, dist);
 }
 
 // Mitsuba 3's mapping in the map's frame: u = atan2(d.x, -d.z) / 2pi wrapped to [0, 1) (the
@@ -146,8 +142,8 @@ vec3 equirect_dir(vec2 uv) {
 // Header (width, cos, sin, height) of the rotation about +Y (--env-rotation), one row-CDF value
 // per row, then per texel (r, g, b, row CDF).
 Emitter env_row(uint k) { return emitters[emitter_count + SCENE_ENV_MAP_BASE + k]; }
-uvec2 env_size() { Emitter h = env_row(0u); return uvec2(h.triangle, h.alias); }
-vec2 env_rotation() { Emitter h = env_row(0u); return vec2(h.select_pdf, h.alias_prob); }
+uvec2 env_size() { Emitter h = env_row(0u); return uvec2(h.triangle, h.leaf); }
+vec2 env_rotation() { Emitter h = env_row(0u); return vec2(uintBitsToFloat(h.trail), h.intensity); }
 
 // d turned about +Y by the angle of (cos, sin) cs. Twin: environment::env_rotate.
 vec3 env_rotate(vec3 d, vec2 cs) { return vec3(cs.x * d.x + cs.y * d.z, d.y, cs.x * d.z - cs.y * d.x); }
@@ -155,7 +151,7 @@ vec3 env_rotate(vec3 d, vec2 cs) { return vec3(cs.x * d.x + cs.y * d.z, d.y, cs.
 // The map's (u, v) of scene direction d, the rotation undone.
 vec2 env_scene_uv(vec3 d) { vec2 cs = env_rotation(); return equirect_uv(env_rotate(d, vec2(cs.x, -cs.y))); }
 float env_cdf(uvec2 size, bool rows, uint i, uint j) {
-    return rows ? uintBitsToFloat(env_row(1u + j).triangle) : uintBitsToFloat(env_row(1u + size.y + i * size.x + j).alias);
+    return rows ? uintBitsToFloat(env_row(1u + j).triangle) : uintBitsToFloat(env_row(1u + size.y + i * size.x + j).leaf);
 }
 
 // The first index j < n whose CDF value exceeds u (n - 1 if none): the rows' CDF, or row i's.
@@ -189,7 +185,7 @@ vec3 environment_radiance(vec3 dir) {
     uvec2 size = env_size();
     uvec2 ij = env_texel_of(size, env_scene_uv(dir));
     Emitter t = env_row(1u + size.y + ij.x * size.x + ij.y);
-    return vec3(uintBitsToFloat(t.triangle), t.select_pdf, t.alias_prob);
+    return vec3(uintBitsToFloat(t.triangle), uintBitsToFloat(t.trail), t.intensity);
 #else
     return scene_env.rgb;
 #endif
@@ -226,11 +222,12 @@ vec3 sample_environment(vec2 u) {
 #endif
 }
 
-// Probability that NEE chooses punctual light k (discrete, not a density).
-float punctual_pdf(uint k) { return (1.0 - env_select_prob()) * punctual_light(k).select_pdf; }
+// The emitter row of punctual light k (its fourth row holds it).
+uint punctual_emitter_row(uint k) { return emitters[light_tree_end() + PUNCTUAL_ROWS * k + 3u].triangle; }
 
-// u.x selects the light, u.yz the point or direction.
-LightSample sample_light(vec3 p, vec3 u) {
+// A light sample from p (geometric normal n, unit, which weighs the lights): u.x selects the
+// environment or a light (light_select), u.yz the point or direction.
+LightSample sample_light(vec3 p, vec3 n, vec3 u) {
     LightSample ls;
     ls.dir = vec3(0.0, 0.0, 1.0);
     ls.dist = 0.0;
@@ -247,7 +244,10 @@ LightSample sample_light(vec3 p, vec3 u) {
     }
     if (SCENE_EMITTERS == 0 || emitter_count == 0u) return ls;
     float u_select = (u.x - p_env) / (1.0 - p_env);
-    Emitter e = emitters[alias_select(min(u_select, 0.99999994), emitter_count)];
+    float pmf;
+    uint row = light_select(p, n, min(u_select, 0.99999994), pmf);
+    if (row == NO_EMITTER) return ls;
+    Emitter e = emitters[row];
 #if SCENE_PUNCTUAL
     if (is_punctual_light(e.triangle)) {
         uint k = e.triangle & ~PUNCTUAL_LIGHT_BIT;
@@ -258,7 +258,7 @@ LightSample sample_light(vec3 p, vec3 u) {
         ls.dir = dir;
         ls.dist = dist;
         ls.radiance = value;
-        ls.pdf = punctual_pdf(k);
+        ls.pdf = pmf;
         ls.triangle = e.triangle;
         return ls;
     }
@@ -273,7 +273,7 @@ LightSample sample_light(vec3 p, vec3 u) {
     ls.dist = sqrt(d2);
     ls.dir = to_light / ls.dist;
     ls.radiance = emitted_radiance(e.triangle, b, -ls.dir);
-    ls.pdf = emitter_pdf(e.triangle, ls.dir, ls.dist);
+    ls.pdf = emitter_area_pdf(pmf, e.triangle, ls.dir, ls.dist);
     return ls;
 }
 

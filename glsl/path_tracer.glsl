@@ -41,6 +41,8 @@ struct PathState {
     vec3 dir;
     vec3 beta;        // throughput of the prefix
     vec3 radiance;    // radiance gathered so far
+    vec3 prev_pos;    // the last scattering vertex and its geometric normal, whose
+    vec3 prev_normal; // light-selection pmf MIS needs
     float prev_pdf;   // solid-angle pdf of the last BSDF sample (for MIS at emitter hits)
     bool prev_delta;  // the last scattering was a delta lobe (or the camera): no MIS
     uint depth;       // segments traced so far
@@ -57,6 +59,8 @@ PathState path_begin(uvec2 pixel, uint seed) {
     s.dir = camera_ray_dir(float(pixel.x) + uc.x, float(pixel.y) + uc.y);
     s.beta = vec3(1.0);
     s.radiance = vec3(0.0);
+    s.prev_pos = s.origin;
+    s.prev_normal = vec3(0.0, 1.0, 0.0);
     s.prev_pdf = 0.0;
     s.prev_delta = true;
     s.depth = 0u;
@@ -95,13 +99,13 @@ bool path_step(inout PathState s) {
     vec3 wo = -s.dir;
     if (SCENE_EMITTERS != 0 && tri.emitter != NO_EMITTER) {
         vec3 le = emitted_radiance(hit.triangle, hit.bary, wo);
-        float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, emitter_pdf(hit.triangle, s.dir, hit.t));
+        float w = s.prev_delta ? 1.0 : power_heuristic(s.prev_pdf, emitter_pdf(s.prev_pos, s.prev_normal, hit.triangle, s.dir, hit.t));
         s.radiance += s.beta * le * w;
     }
     if (s.depth >= max_depth) return false;
 
     vec4 ul = rng_uniform4(s.seed, s.depth, STREAM_LIGHT);
-    LightSample ls = sample_light(x, ul.xyz);
+    LightSample ls = sample_light(x, ng, ul.xyz);
     if (ls.pdf > 0.0 && max_component(ls.radiance) > 0.0) {
         float bsdf_pdf;
         vec3 f = bsdf_eval_pdf(m, ng, ns, wo, ls.dir, bsdf_pdf);
@@ -118,6 +122,8 @@ bool path_step(inout PathState s) {
     BsdfSample bs = bsdf_sample(m, ng, ns, wo, rng_uniform4(s.seed, s.depth, STREAM_BSDF));
     if (bs.lobe == LOBE_NONE) return s.shadow.tmax > 0.0;
     s.beta *= bs.weight;
+    s.prev_pos = x;
+    s.prev_normal = ng;
     s.prev_pdf = bs.pdf;
     s.prev_delta = (bs.lobe & LOBE_DELTA) != 0u;
     if ((flags & FLAG_RUSSIAN_ROULETTE) != 0u && s.depth >= RR_START_DEPTH) {

@@ -58,7 +58,7 @@ uint reconnection_index(Path path, ShiftParams params) {
 // The light point NEE at x_i chooses with the path's random numbers; false if none can be chosen.
 // Visibility is left to the caller.
 bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex light) {
-    ls = sample_light(x.pos, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
+    ls = sample_light(x.pos, x.normal, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
     if (!(ls.pdf > 0.0)) return false;
     if (SCENE_PUNCTUAL != 0 && is_punctual_light(ls.triangle)) {
         light = vertex_punctual(ls.triangle);

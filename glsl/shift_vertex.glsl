@@ -132,14 +132,19 @@ vec3 end_emission(Vertex from, Vertex end) {
     return emitted_radiance(end.triangle, triangle_bary(tri, end.pos), normalize(from.pos - end.pos));
 }
 
-// For a punctual light: the discrete probability of choosing it (whose ratio between two paths
-// to the same light is 1, as its geometry term is).
+// The pdf that NEE at `from` picks `end` (solid angle); for a punctual light the discrete
+// probability of choosing it (whose ratio between two paths to the same light is 1, as its
+// geometry term is). One light_select_pmf for every kind keeps one copy of the tree walk.
 float light_pdf(Vertex from, Vertex end) {
-    if (vertex_is_punctual(end)) return punctual_pdf(vertex_light(end));
     vec3 dir;
     float dist;
     direction(from, end, dir, dist);
-    return vertex_is_escaped(end) ? environment_pdf(dir) : emitter_pdf(end.triangle, dir, dist);
+    if (vertex_is_escaped(end)) return environment_pdf(dir);
+    bool punctual = vertex_is_punctual(end);
+    uint row = punctual ? punctual_emitter_row(vertex_light(end)) : triangles[end.triangle].emitter;
+    if (row == NO_EMITTER) return 0.0;
+    float pmf = light_select_pmf(from.pos, from.normal, row);
+    return punctual ? pmf : emitter_area_pdf(pmf, end.triangle, dir, dist);
 }
 
 // Balance-heuristic weight of the technique that ended a path at `end` from `x` (reached from

@@ -45,15 +45,16 @@ struct BvhNode {
 const uint LEAF_COUNT_BITS = 4u;
 const uint LEAF_COUNT_MASK = 15u;
 
-// One emissive triangle or punctual light with its alias-table entry (selection proportional
-// to power). After the emitter_count entries, the buffer holds PUNCTUAL_ROWS rows per punctual
-// light, each 16-byte row read as four words: (position, kind), (direction, cos outer),
-// (intensity, cos inner), (select pdf, 0, 0, 0). Twin: gpu_types::punctual_rows.
+// One light NEE can choose: emissive triangles, then point and spot lights (the light tree's
+// leaves), then directional lights. After the emitter_count entries, the buffer holds the light
+// tree (light_tree.glsl), then PUNCTUAL_ROWS rows per punctual light, each 16-byte row read as
+// four words: (position, kind), (direction, cos outer), (intensity, cos inner), (emitter row, 0,
+// 0, 0); then the environment map. Twin: gpu_types::Emitter, gpu_types::punctual_rows.
 struct Emitter {
     uint triangle;      // the triangle, or PUNCTUAL_LIGHT_BIT | light index
-    float select_pdf;
-    float alias_prob;
-    uint alias;
+    uint trail;         // the light tree's bit trail from the root to this light's leaf
+    float intensity;    // largest radiant intensity (luminance, W/sr)
+    uint leaf;          // the light tree node of its leaf (NO_EMITTER: a directional light)
 };
 const uint PUNCTUAL_LIGHT_BIT = 0x80000000u;
 const uint PUNCTUAL_POINT = 0u;

@@ -108,54 +108,118 @@ impl BvhNode {
     }
 }
 
-/// One emissive triangle or punctual light with its entry of the alias table (Walker/Vose; pbrt-v4
-/// `AliasTable`) that picks emitters in proportion to their power (glsl/types.glsl `Emitter`,
-/// 16 bytes, std430). The punctual lights' parameter rows follow the table in the same buffer
-/// ([`punctual_rows`]).
+/// One light that next-event estimation can choose (glsl/types.glsl `Emitter`, 16 bytes, std430):
+/// the emissive triangles first (a triangle's [`Triangle::emitter`] is its row), then the point
+/// and spot lights, then the directional lights. The lights before the directional ones are the
+/// leaves of the light tree ([`LightNode`]); each row keeps the path from the tree's root to its
+/// leaf so that the selection probability can be recomputed at any shading point. The light
+/// tree, the punctual lights' parameter rows and the environment map follow in the same buffer
+/// ([`LightNode::rows`], [`punctual_rows`]), each 16-byte row read as four 32-bit words.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Emitter {
     /// The emissive triangle's index, or [`PUNCTUAL_LIGHT_BIT`] | the punctual light's index.
     pub triangle: u32,
-    /// Probability that light sampling picks this emitter, given that it picks an emitter and not
-    /// the environment (discrete; the emitters' values sum to 1).
-    pub select_pdf: f32,
-    /// Probability of keeping this slot of the alias table when a uniform draw lands on it; the
-    /// rest goes to `alias`.
-    pub alias_prob: f32,
-    /// The emitter index a draw on this slot falls to with probability `1 - alias_prob`.
-    pub alias: u32,
+    /// The light tree's bit trail (pbrt-v4 `BVHLightSampler`): bit d set when the path from the
+    /// root to this light's leaf takes the second child at depth d. For a directional light,
+    /// its direction (`shading::light_tree::octahedral_encode`).
+    pub trail: u32,
+    /// The light's largest radiant intensity, luminance (W/sr in the glTF emission unit): L·A
+    /// for an emissive triangle, I for a point or spot light, the irradiance E for a
+    /// directional light.
+    pub intensity: f32,
+    /// Index of the light's leaf among the light tree's nodes; `NO_EMITTER` for directional
+    /// lights, which are chosen beside the tree.
+    pub leaf: u32,
+}
+
+impl Emitter {
+    /// A row of four raw words (the punctual, light-tree and environment rows).
+    pub fn from_words(w: [u32; 4]) -> Self {
+        Self {
+            triangle: w[0],
+            trail: w[1],
+            intensity: f32::from_bits(w[2]),
+            leaf: w[3],
+        }
+    }
 }
 
 /// Set in `Emitter::triangle` (and in path vertices' triangle ids) for a punctual light: the low
 /// bits are the light's index in `Scene::lights`. Triangle indices stay below 2^26.
 pub const PUNCTUAL_LIGHT_BIT: u32 = 1 << 31;
 
-/// Rows of the emitter buffer per punctual light, after the alias table (glsl/types.glsl):
-/// (position, kind), (direction, cos outer), (intensity, cos inner), (select pdf, 0, 0, 0).
+/// Rows of the emitter buffer per punctual light, after the light tree (glsl/types.glsl):
+/// (position, kind), (direction, cos outer), (intensity, cos inner), (emitter row, 0, 0, 0).
 pub const PUNCTUAL_ROWS: usize = 4;
 
-/// The emitter-buffer rows of punctual lights (`select_pdfs[k]`: light k's probability in the
-/// alias table), reinterpreting each 16-byte row as four 32-bit words.
-pub fn punctual_rows(lights: &[crate::scene::PunctualLight], select_pdfs: &[f32]) -> Vec<Emitter> {
-    let row = |a: [f32; 3], w: u32| Emitter {
-        triangle: a[0].to_bits(),
-        select_pdf: a[1],
-        alias_prob: a[2],
-        alias: w,
-    };
+/// The emitter-buffer rows of punctual lights (`emitter_rows[k]`: the row of light k among the
+/// [`Emitter`]s), reinterpreting each 16-byte row as four 32-bit words.
+pub fn punctual_rows(lights: &[crate::scene::PunctualLight], emitter_rows: &[u32]) -> Vec<Emitter> {
+    let row = |a: [f32; 3], w: u32| Emitter::from_words([a[0].to_bits(), a[1].to_bits(), a[2].to_bits(), w]);
     lights
         .iter()
-        .zip(select_pdfs)
-        .flat_map(|(l, &pdf)| {
+        .zip(emitter_rows)
+        .flat_map(|(l, &r)| {
             [
                 row(l.position.into(), l.kind as u32),
                 row(l.direction.into(), l.cos_outer.to_bits()),
                 row(l.intensity.into(), l.cos_inner.to_bits()),
-                row([pdf, 0.0, 0.0], 0),
+                Emitter::from_words([r, 0, 0, 0]),
             ]
         })
         .collect()
+}
+
+/// [`LightNode::flags`] bit: a leaf, whose `child` is the light's emitter row.
+pub const LIGHT_NODE_LEAF: u32 = 1;
+/// [`LightNode::flags`] bit: the lights below may emit on both sides of their cone (pbrt-v4
+/// `LightBounds::twoSided`): the importance folds the angle to the axis into [0, π/2].
+pub const LIGHT_NODE_TWO_SIDED: u32 = 2;
+/// Emitter-buffer rows per light-tree node ([`LightNode::rows`]).
+pub const LIGHT_NODE_ROWS: usize = 4;
+/// The light tree is at most this deep: a bit trail is one 32-bit word.
+pub const LIGHT_TREE_MAX_DEPTH: usize = 32;
+
+/// A node of the light tree (pbrt-v4 `LightBVHNode` with uncompressed `LightBounds`; Conty
+/// Estevez & Kulla 2018): the bounds of the lights below it in scene coordinates, the sum of
+/// their largest radiant intensities, and the cone of their emission directions: every light
+/// below emits only along directions within θ_o + θ_e of `axis` (θ_o bounds the lights'
+/// normals or spot axes, θ_e the spread about each). Depth-first: an interior node's first child
+/// follows it, `child` is its second. glsl/light_tree.glsl reads it as [`LIGHT_NODE_ROWS`] rows.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct LightNode {
+    /// Lower corner of the bounds.
+    pub lo: [f32; 3],
+    /// Sum of the lights' largest radiant intensities (luminance, W/sr).
+    pub intensity: f32,
+    /// Upper corner of the bounds.
+    pub hi: [f32; 3],
+    /// cos θ_o, θ_o the half-angle of the cone of normals (1: one direction, -1: all).
+    pub cos_theta_o: f32,
+    /// Unit axis of the cone of normals.
+    pub axis: [f32; 3],
+    /// cos θ_e, θ_e the angle beyond θ_o within which the lights still emit (0: a cosine lobe).
+    pub cos_theta_e: f32,
+    /// A leaf's emitter row, an interior node's second child.
+    pub child: u32,
+    /// [`LIGHT_NODE_LEAF`] | [`LIGHT_NODE_TWO_SIDED`].
+    pub flags: u32,
+    /// Zero; pads the node to whole rows.
+    pub pad: [u32; 2],
+}
+
+impl LightNode {
+    /// The node as emitter-buffer rows.
+    pub fn rows(&self) -> [Emitter; LIGHT_NODE_ROWS] {
+        bytemuck::cast(*self)
+    }
+
+    /// Whether the node is a leaf.
+    pub fn is_leaf(&self) -> bool {
+        self.flags & LIGHT_NODE_LEAF != 0
+    }
 }
 
 impl Material {
@@ -201,7 +265,7 @@ pub struct FrameParams {
     /// xyz: the camera's unit viewing direction, scene coordinates; w unused (0).
     pub cam_forward: [f32; 4],
     /// rgb: constant environment radiance (linear, W/(m² sr)); w: probability that light
-    /// sampling picks the environment instead of an emitter.
+    /// sampling picks the environment instead of another light.
     pub scene_env: [f32; 4],
     /// Image width in pixels.
     pub width: u32,
@@ -218,7 +282,8 @@ pub struct FrameParams {
     pub render_seed: u32,
     /// Bit set: [`FLAG_RUSSIAN_ROULETTE`].
     pub flags: u32,
-    /// Entries of the emitter alias table; punctual-light rows follow them in the buffer.
+    /// Rows of [`Emitter`]s (every light but the environment); the punctual-light rows, the
+    /// light tree and the environment map follow them in the buffer.
     pub emitter_count: u32,
 }
 

@@ -253,6 +253,10 @@ fn build_header() -> String {
         ("COUNTER_COUNT", COUNTER_COUNT as u32),
         ("MAX_PATH_LENGTH", crate::shading::path_record::MAX_PATH_LENGTH as u32),
         ("PUNCTUAL_ROWS", crate::gpu_types::PUNCTUAL_ROWS as u32),
+        ("LIGHT_NODE_ROWS", crate::gpu_types::LIGHT_NODE_ROWS as u32),
+        ("LIGHT_TREE_MAX_DEPTH", crate::gpu_types::LIGHT_TREE_MAX_DEPTH as u32),
+        ("LIGHT_NODE_LEAF", crate::gpu_types::LIGHT_NODE_LEAF),
+        ("LIGHT_NODE_TWO_SIDED", crate::gpu_types::LIGHT_NODE_TWO_SIDED),
     ];
     h.push('\n');
     for (name, value) in limits {

@@ -25,10 +25,20 @@ void main() {
     vec2 px = inputs[4u * i + 3u].xy;
     Hit h = trace_closest(o.xyz, d, o.w);
     bool occluded = trace_occluded(o.xyz, d, o.w);
-    LightSample ls = sample_light(o.xyz, u);
+    // The ray direction stands in for the shading point's normal.
+    LightSample ls = sample_light(o.xyz, d, u);
     uint offset_triangle = i % uint(SCENE_TRIANGLES_LENGTH);
     bool shadowed = is_punctual_light(ls.triangle) && punctual_occluded(o.xyz, d, offset_triangle, ls.dir, ls.dist);
-    outputs[6u * i + 5u] = vec4(shadowed ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+    // The pdf of the same sample recomputed as MIS and the shifts do (light_select_pmf's walk
+    // along the light's bit trail): it must equal ls.pdf.
+    float pdf_again = 0.0;
+    if (ls.pdf > 0.0) {
+        uint row = is_punctual_light(ls.triangle) ? punctual_emitter_row(ls.triangle & ~PUNCTUAL_LIGHT_BIT) : NO_EMITTER;
+        if (ls.triangle == NO_EMITTER) pdf_again = environment_pdf(ls.dir);
+        else if (row != NO_EMITTER) pdf_again = light_select_pmf(o.xyz, d, row);
+        else pdf_again = emitter_pdf(o.xyz, d, ls.triangle, ls.dir, ls.dist);
+    }
+    outputs[6u * i + 5u] = vec4(shadowed ? 1.0 : 0.0, pdf_again, 0.0, 0.0);
     outputs[6u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
     outputs[6u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d, triangles[offset_triangle]));
     outputs[6u * i + 2u] = vec4(ls.dir, ls.dist);

@@ -109,9 +109,10 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
         println!("{line}");
     }
     println!(
-        "emitters: {} triangles, power {:.4} (luminance W)",
-        scene.emitters.len(),
-        scene.emitter_power
+        "emitters: {} triangles, power {:.4} (luminance W); light tree: {} nodes",
+        scene.emitters.len() - scene.lights.len(),
+        scene.emitter_power,
+        scene.light_nodes.len()
     );
     match &scene.environment_map {
         Some(map) => println!(

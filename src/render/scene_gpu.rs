@@ -13,7 +13,7 @@ use anyhow::{Context as _, Result};
 use ash::vk::PhysicalDeviceType;
 
 use crate::error::GpuError;
-use crate::gpu_types::{Emitter, Material, Triangle, PUNCTUAL_ROWS};
+use crate::gpu_types::{Emitter, Material, Triangle, LIGHT_NODE_ROWS, PUNCTUAL_ROWS};
 use crate::scene::Scene;
 use crate::shader_interface::SceneBinding;
 use crate::shading::bsdf::{has_specular_layer, lobe_weights};
@@ -35,8 +35,9 @@ pub struct SceneGpu {
     pub nodes: Buffer,
     /// `Material` records, indexed by a triangle's material (one default if none).
     pub materials: Buffer,
-    /// `Emitter` rows: emissive triangles, then `PUNCTUAL_ROWS` per punctual light, then the
-    /// environment map's sampling rows.
+    /// `Emitter` rows: the lights (`Scene::emitters`), the light tree
+    /// (`Scene::light_tree_rows`), `PUNCTUAL_ROWS` per punctual light and the environment
+    /// map's sampling rows.
     pub emitters: Buffer,
     /// Scene arrays are bound as uniform buffers (CPU devices, small scenes), else storage buffers.
     pub uniform: bool,
@@ -71,6 +72,7 @@ impl SceneGpu {
             .emitters
             .iter()
             .copied()
+            .chain(scene.light_tree_rows())
             .chain(scene.punctual_rows())
             .chain(env_rows)
             .collect();
@@ -240,6 +242,8 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         .collect();
     let used = |pick: fn((f32, f32, f32)) -> f32| variants.iter().any(|m| pick(lobe_weights(m)) > 0.0);
     let flag = |on: bool| if on { "1" } else { "0" }.to_string();
+    // The light tree's rows (with its header) and the punctual lights', after the emitters.
+    let light_rows = PUNCTUAL_ROWS * scene.lights.len() + 1 + LIGHT_NODE_ROWS * scene.light_nodes.len();
     let mut defines = vec![
         ("BSDF_DIFFUSE", flag(used(|w| w.0))),
         ("BSDF_CONDUCTOR", flag(used(|w| w.1))),
@@ -250,7 +254,7 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
         ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),
         ("SCENE_ENV_MAP", flag(scene.environment_map.is_some())),
-        ("SCENE_ENV_MAP_BASE", format!("{}u", PUNCTUAL_ROWS * scene.lights.len())),
+        ("SCENE_ENV_MAP_BASE", format!("{}u", light_rows)),
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),
         ("SCENE_SURFACE", flag(!scene.surfaces.is_empty())),
         ("SCENE_TEXTURES", flag(!scene.surfaces.is_empty() && !scene.textures.is_empty())),
@@ -268,7 +272,7 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
             (
                 "SCENE_EMITTER_SLOTS",
                 (scene.emitters.len()
-                    + PUNCTUAL_ROWS * scene.lights.len()
+                    + light_rows
                     + scene
                         .environment_map
                         .as_ref()

@@ -53,6 +53,10 @@ pub const BUNDLED_SCENES: &[BundledScene] = &[
         file_name: "furnace.gltf",
         build: furnace,
     },
+    BundledScene {
+        file_name: "many-lights.gltf",
+        build: crate::scene::many_lights_scene::many_lights,
+    },
 ];
 
 const WHITE: Vec3 = Vec3::new(0.73, 0.73, 0.73);

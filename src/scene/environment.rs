@@ -218,22 +218,16 @@ impl EnvironmentMap {
     /// (width, cos, sin, height) with the rotation's cosine and sine, the row CDF (one per row),
     /// then per texel (r, g, b, row CDF value).
     pub fn gpu_rows(&self) -> Vec<Emitter> {
-        let header = Emitter {
-            triangle: self.width,
-            select_pdf: self.rotation.x,
-            alias_prob: self.rotation.y,
-            alias: self.height,
-        };
+        let header = Emitter::from_words([self.width, self.rotation.x.to_bits(), self.rotation.y.to_bits(), self.height]);
         let rows = self.row_cdf.iter().map(|&c| Emitter {
             triangle: c.to_bits(),
             ..Default::default()
         });
-        let texels = self.texels.iter().zip(&self.texel_cdf).map(|(t, &c)| Emitter {
-            triangle: t.x.to_bits(),
-            select_pdf: t.y,
-            alias_prob: t.z,
-            alias: c.to_bits(),
-        });
+        let texels = self
+            .texels
+            .iter()
+            .zip(&self.texel_cdf)
+            .map(|(t, &c)| Emitter::from_words([t.x.to_bits(), t.y.to_bits(), t.z.to_bits(), c.to_bits()]));
         std::iter::once(header).chain(rows).chain(texels).collect()
     }
 }

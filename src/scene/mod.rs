@@ -15,6 +15,8 @@ mod gltf_surface;
 mod gltf_texture;
 pub mod gltf_writer;
 mod hit_surface;
+pub mod light_tree;
+pub mod many_lights_scene;
 mod punctual;
 
 pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
@@ -31,14 +33,14 @@ pub use crate::metrics::luminance;
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
-use crate::gpu_types::{BvhNode, Emitter, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use crate::gpu_types::{BvhNode, Emitter, LightNode, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::bvh::Bvh;
 use crate::scene::environment::EnvironmentMap;
-use crate::shading::lights::build_alias_table;
+use crate::scene::light_tree::{LightBounds, LightTree};
 use crate::shading::surface::TriangleSurface;
 use crate::shading::texture::{SceneTextures, ALPHA_OPAQUE};
 
-/// Probability that NEE samples the environment when the scene also has emissive triangles.
+/// Probability that NEE samples the environment when the scene also has other lights.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
 
 /// A scene ready to upload: what [`load_scene`] returns and the renderers draw. Positions are
@@ -59,17 +61,25 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// The materials' names from the file, parallel to `materials` (for messages and reports).
     pub material_names: Vec<String>,
-    /// Light-sampling table: emissive triangles then punctual lights, each with its alias-table
-    /// entry and selection pdf.
+    /// The lights NEE chooses from: emissive triangles, then point and spot lights (the light
+    /// tree's leaves, each with its bit trail), then directional lights.
     pub emitters: Vec<Emitter>,
+    /// The light tree over the emitters before the directional ones (src/scene/light_tree.rs);
+    /// empty when there are none.
+    pub light_nodes: Vec<LightNode>,
+    /// Directional lights: the last rows of `emitters`, chosen beside the light tree
+    /// (`shading::light_tree::light_select`).
+    pub directional_count: u32,
+    /// Per punctual light (index into `lights`): its row in `emitters`.
+    pub punctual_emitter_rows: Vec<u32>,
     /// Total emitted power of the emissive triangles (W, luminance-weighted, front faces).
     pub emitter_power: f32,
     /// Constant environment radiance (unused when `environment_map` is set).
     pub environment: Vec3,
     /// An equirectangular environment map (`--env FILE`), replacing the constant.
     pub environment_map: Option<EnvironmentMap>,
-    /// Probability that next-event estimation samples the environment rather than the emitter
-    /// table (0 without environment light, 1 without emitters).
+    /// Probability that next-event estimation samples the environment rather than another light
+    /// (0 without environment light, 1 without other lights).
     pub env_select_prob: f32,
     /// The file's cameras, or one default camera framing the scene; never empty.
     pub cameras: Vec<Camera>,
@@ -118,11 +128,12 @@ pub struct SceneParts {
 }
 
 /// Sets each triangle's emitter index (into the triangle emitters, in order; `NO_EMITTER` if it
-/// emits nothing) and `alpha_tested` flag; returns the emitting triangles' indices and powers
-/// (luminance × area × π per emitting side, in scene units).
-fn tag_triangles(triangles: &mut [Triangle], materials: &[Material], textures: &SceneTextures) -> (Vec<u32>, Vec<f32>) {
+/// emits nothing) and `alpha_tested` flag; returns the emitting triangles' indices, light bounds
+/// and total power (luminance × area × π per emitting side, in scene units).
+fn tag_triangles(triangles: &mut [Triangle], materials: &[Material], textures: &SceneTextures) -> (Vec<u32>, Vec<LightBounds>, f32) {
     let mut emitter_tris = Vec::new();
-    let mut powers = Vec::new();
+    let mut bounds = Vec::new();
+    let mut total = 0.0;
     for (i, tri) in triangles.iter_mut().enumerate() {
         let m = &materials[tri.material as usize];
         let sides = if m.is_double_sided() { 2.0 } else { 1.0 };
@@ -133,10 +144,53 @@ fn tag_triangles(triangles: &mut [Triangle], materials: &[Material], textures: &
         if power > 0.0 {
             tri.emitter = emitter_tris.len() as u32;
             emitter_tris.push(i as u32);
-            powers.push(power);
+            bounds.push(LightBounds::triangle(
+                tri.vertices(),
+                luminance(Vec3::from(m.emission)),
+                m.is_double_sided(),
+            ));
+            total += power;
         }
     }
-    (emitter_tris, powers)
+    (emitter_tris, bounds, total)
+}
+
+/// The emitter rows of the scene's lights (see [`Scene::emitters`]), the light tree over all
+/// but the directional ones, and each punctual light's row.
+fn light_table(mut ids: Vec<u32>, mut bounds: Vec<LightBounds>, lights: &[PunctualLight]) -> (Vec<Emitter>, LightTree, Vec<u32>) {
+    let mut rows = vec![0u32; lights.len()];
+    let directional = |l: &PunctualLight| l.kind == PunctualKind::Directional;
+    for (k, light) in lights.iter().enumerate().filter(|(_, l)| !directional(l)) {
+        rows[k] = ids.len() as u32;
+        ids.push(PUNCTUAL_LIGHT_BIT | k as u32);
+        bounds.push(LightBounds::punctual(
+            light.position,
+            light.direction,
+            luminance(light.intensity),
+            light.cos_outer,
+        ));
+    }
+    let tree = LightTree::build(&bounds);
+    let mut emitters: Vec<Emitter> = ids
+        .iter()
+        .enumerate()
+        .map(|(i, &id)| Emitter {
+            triangle: id,
+            trail: tree.trails[i],
+            intensity: bounds[i].intensity,
+            leaf: tree.leaves[i],
+        })
+        .collect();
+    for (k, light) in lights.iter().enumerate().filter(|(_, l)| directional(l)) {
+        rows[k] = emitters.len() as u32;
+        emitters.push(Emitter {
+            triangle: PUNCTUAL_LIGHT_BIT | k as u32,
+            trail: crate::shading::light_tree::octahedral_encode(light.direction),
+            intensity: luminance(light.intensity),
+            leaf: NO_EMITTER,
+        });
+    }
+    (emitters, tree, rows)
 }
 
 impl Scene {
@@ -153,24 +207,8 @@ impl Scene {
             permute_in_place(&mut surfaces, bvh.order.clone());
         }
         permute_in_place(&mut triangles, bvh.order);
-        let (mut emitter_tris, mut powers) = tag_triangles(&mut triangles, &parts.materials, &parts.textures);
-        let triangle_power = powers.iter().fold(0.0, |a, p| a + p);
-        // Punctual lights join the alias table after the triangles, chosen by power too.
-        let bounds = (Vec3::from(bvh.nodes[0].lo), Vec3::from(bvh.nodes[0].hi));
-        let scene_radius = if triangles.is_empty() {
-            1.0
-        } else {
-            0.5 * (bounds.1 - bounds.0).length()
-        };
-        for (k, light) in parts.lights.iter().enumerate() {
-            emitter_tris.push(PUNCTUAL_LIGHT_BIT | k as u32);
-            powers.push(light.power(scene_radius).max(f32::MIN_POSITIVE));
-        }
-        let emitters = if emitter_tris.is_empty() {
-            Vec::new()
-        } else {
-            build_alias_table(&emitter_tris, &powers)
-        };
+        let (emitter_tris, bounds, triangle_power) = tag_triangles(&mut triangles, &parts.materials, &parts.textures);
+        let (emitters, tree, punctual_emitter_rows) = light_table(emitter_tris, bounds, &parts.lights);
         let has_env = luminance(parts.environment) > 0.0 || parts.environment_map.is_some();
         let env_select_prob = match (has_env, emitters.is_empty()) {
             (false, _) => 0.0,
@@ -187,7 +225,10 @@ impl Scene {
             nodes: bvh.nodes,
             materials: parts.materials,
             material_names: parts.material_names,
+            directional_count: (emitters.len() - tree.trails.len()) as u32,
             emitters,
+            light_nodes: tree.nodes,
+            punctual_emitter_rows,
             emitter_power: triangle_power,
             environment: if parts.environment_map.is_some() {
                 Vec3::ZERO
@@ -210,16 +251,18 @@ impl Scene {
         }
     }
 
-    /// The probability that light selection (given it chose no environment) picks punctual light
-    /// `k`: its alias-table entry follows the emissive triangles'.
-    pub fn light_select_pdf(&self, k: usize) -> f32 {
-        self.emitters[self.emitters.len() - self.lights.len() + k].select_pdf
-    }
-
     /// The emitter-buffer rows of the punctual lights (see `gpu_types::punctual_rows`).
     pub fn punctual_rows(&self) -> Vec<Emitter> {
-        let pdfs: Vec<f32> = (0..self.lights.len()).map(|k| self.light_select_pdf(k)).collect();
-        crate::gpu_types::punctual_rows(&self.lights, &pdfs)
+        crate::gpu_types::punctual_rows(&self.lights, &self.punctual_emitter_rows)
+    }
+
+    /// The emitter-buffer rows of the light tree (glsl/light_tree.glsl): a header (directional
+    /// lights, nodes, 0, 0), then [`crate::gpu_types::LIGHT_NODE_ROWS`] rows per node.
+    pub fn light_tree_rows(&self) -> Vec<Emitter> {
+        let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, 0, 0]);
+        std::iter::once(header)
+            .chain(self.light_nodes.iter().flat_map(|n| n.rows()))
+            .collect()
     }
 
     /// Replaces the environment by the constant radiance `env` (no map), with the light

@@ -41,25 +41,6 @@ pub struct PunctualLight {
     pub cos_outer: f32,
 }
 
-impl PunctualLight {
-    /// Emitted power (luminance-weighted) used to choose lights in NEE in proportion to power
-    /// beside emissive triangles: 4πI for a point light, the solid angle of the cone halfway
-    /// between the inner and outer angles times I for a spot, and I times the area of the
-    /// scene's bounding disc (radius `scene_radius`) for a directional light (as pbrt-v4's
-    /// DistantLight::Phi).
-    pub fn power(&self, scene_radius: f32) -> f32 {
-        let i = luminance(self.intensity);
-        match self.kind {
-            PunctualKind::Point => 4.0 * std::f32::consts::PI * i,
-            PunctualKind::Spot => {
-                let cos_mid = 0.5 * (self.cos_inner + self.cos_outer);
-                2.0 * std::f32::consts::PI * (1.0 - cos_mid) * i
-            }
-            PunctualKind::Directional => std::f32::consts::PI * scene_radius * scene_radius * i,
-        }
-    }
-}
-
 impl Loader<'_> {
     /// Adds the light of `node` with world transform `world`; its position is kept in f64 world
     /// space (`light_positions`) until the walk has chosen the scene's origin.

@@ -1,12 +1,14 @@
-//! Next-event estimation: the alias table over emitter power and the twin of glsl/lights.glsl.
-//! Punctual lights (KHR_lights_punctual) share the alias table with emissive triangles; a sample
-//! of one is a delta: its `pdf` is the discrete probability of choosing the light, its
-//! `radiance` the irradiance-like I·falloff/d² (or E), and MIS gives it weight 1.
+//! Next-event estimation: the twin of glsl/lights.glsl. Lights are chosen by their likely
+//! contribution at the shading point (the light tree, src/shading/light_tree.rs); punctual
+//! lights (KHR_lights_punctual) are chosen beside emissive triangles, and a sample of one is a
+//! delta: its `pdf` is the discrete probability of choosing the light, its `radiance` the
+//! irradiance-like I·falloff/d² (or E), and MIS gives it weight 1.
 
 use glam::{Vec2, Vec3};
 
-use crate::gpu_types::{Emitter, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::{PunctualKind, PunctualLight, Scene};
+use crate::shading::light_tree::{light_select, light_select_pmf};
 use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
 /// A next-event-estimation sample from a shading point (twin of GLSL `LightSample`,
@@ -81,42 +83,9 @@ pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, tri: u32, dir: Vec3, d
     )
 }
 
-/// The probability that NEE chooses punctual light `k` (a discrete probability, not a density).
-/// Twin of GLSL `punctual_pdf`.
-pub fn punctual_pdf(scene: &Scene, k: u32) -> f32 {
-    (1.0 - scene.env_select_prob) * scene.light_select_pdf(k as usize)
-}
-
-/// Vose's alias table over `weights` (all finite, non-negative, positive sum).
-pub fn build_alias_table(triangles: &[u32], weights: &[f32]) -> Vec<Emitter> {
-    let n = weights.len();
-    let total: f64 = weights.iter().map(|&w| w as f64).sum();
-    let mut table: Vec<Emitter> = triangles
-        .iter()
-        .zip(weights)
-        .map(|(&t, &w)| Emitter {
-            triangle: t,
-            select_pdf: (w as f64 / total) as f32,
-            alias_prob: 1.0,
-            alias: 0,
-        })
-        .collect();
-    let mut scaled: Vec<f64> = weights.iter().map(|&w| w as f64 * n as f64 / total).collect();
-    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
-    while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
-        table[s].alias_prob = scaled[s] as f32;
-        table[s].alias = l as u32;
-        scaled[l] -= 1.0 - scaled[s];
-        if scaled[l] < 1.0 {
-            large.pop();
-            small.push(l);
-        }
-    }
-    for i in small.into_iter().chain(large) {
-        table[i].alias_prob = 1.0;
-        table[i].alias = i as u32;
-    }
-    table
+/// The emitter row of punctual light `k`. Twin of GLSL `punctual_emitter_row`.
+pub fn punctual_emitter_row(scene: &Scene, k: u32) -> u32 {
+    scene.punctual_emitter_rows[k as usize]
 }
 
 /// Emitted radiance of triangle index `triangle` at barycentrics `bary` towards `to_viewer`
@@ -133,38 +102,32 @@ pub fn emitted_radiance(scene: &Scene, triangle: u32, bary: glam::Vec2, to_viewe
     }
 }
 
-/// The emitter index the alias table `emitters[..count]` gives for uniform `u` in [0, 1): slot
-/// floor(u · count), kept if the remaining fraction is below its `alias_prob`, else its `alias`
-/// (one uniform does both, Vose's method as in pbrt-v4 `AliasTable::Sample`). Twin of GLSL
-/// `alias_select`.
-pub fn alias_select(emitters: &[Emitter], u: f32, count: u32) -> u32 {
-    let scaled = u * count as f32;
-    let i = (scaled as u32).min(count - 1);
-    let coin = scaled - i as f32;
-    if coin < emitters[i as usize].alias_prob {
-        i
-    } else {
-        emitters[i as usize].alias
-    }
-}
-
-/// Solid-angle density (1/sr) with which [`sample_light`] picks the point at distance `dist`
-/// along unit `dir` on emissive triangle `tri_index`: (1 - env_select_prob) · select_pdf / area
-/// · dist² / |cos θ_light|. 0 for a triangle that does not emit or is seen edge-on. Twin of GLSL
-/// `emitter_pdf`.
-pub fn emitter_pdf(scene: &Scene, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
-    let tri = &scene.triangles[tri_index as usize];
-    if tri.emitter == NO_EMITTER {
-        return 0.0;
-    }
-    let ng = tri.normal_area2();
+/// The solid-angle density (1/sr) of the point at distance `dist` along unit `dir` on emitter
+/// triangle `tri_index` when the triangle is chosen with probability `pmf` and sampled
+/// uniformly by area: pmf / area · dist² / |cos θ_light|; 0 seen edge-on. Twin of GLSL
+/// `emitter_area_pdf`.
+pub fn emitter_area_pdf(scene: &Scene, pmf: f32, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
+    let ng = scene.triangles[tri_index as usize].normal_area2();
     let area2 = ng.length();
     let cos_l = ng.dot(dir).abs() / area2;
     if cos_l <= 0.0 {
         return 0.0;
     }
-    let p_area = (1.0 - scene.env_select_prob) * scene.emitters[tri.emitter as usize].select_pdf * 2.0 / area2;
+    let p_area = pmf * 2.0 / area2;
     p_area * dist * dist / cos_l
+}
+
+/// Solid-angle density (1/sr) with which [`sample_light`] at `p` (geometric normal `n`) picks
+/// the point at distance `dist` along unit `dir` on emissive triangle `tri_index` (see
+/// [`emitter_area_pdf`] and [`light_select_pmf`]); 0 for a triangle that does not emit. Twin
+/// of GLSL `emitter_pdf`.
+pub fn emitter_pdf(scene: &Scene, p: Vec3, n: Vec3, tri_index: u32, dir: Vec3, dist: f32) -> f32 {
+    let row = scene.triangles[tri_index as usize].emitter;
+    if row == NO_EMITTER {
+        0.0
+    } else {
+        emitter_area_pdf(scene, light_select_pmf(scene, p, n, row), tri_index, dir, dist)
+    }
 }
 
 /// Solid-angle pdf that NEE samples the environment in direction `dir` (unit): uniform over the
@@ -187,8 +150,10 @@ pub fn environment_radiance(scene: &Scene, dir: Vec3) -> Vec3 {
     }
 }
 
-/// u.x selects the light, u.yz the point or direction.
-pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
+/// A light sample from `p` (geometric normal `n`, unit, which weighs the lights): u.x selects
+/// the environment or a light (by [`light_select`]), u.yz the point or direction. Twin of GLSL
+/// `sample_light`.
+pub fn sample_light(scene: &Scene, p: Vec3, n: Vec3, u: Vec3) -> LightSample {
     let none = LightSample {
         dir: Vec3::Z,
         dist: 0.0,
@@ -214,7 +179,11 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
         return none;
     }
     let u_select = (u.x - p_env) / (1.0 - p_env);
-    let e = scene.emitters[alias_select(&scene.emitters, u_select.min(0.99999994), scene.emitters.len() as u32) as usize];
+    let (row, pmf) = light_select(scene, p, n, u_select.min(0.99999994));
+    if row == NO_EMITTER {
+        return none;
+    }
+    let e = scene.emitters[row as usize];
     if is_punctual_light(e.triangle) {
         let k = e.triangle & !PUNCTUAL_LIGHT_BIT;
         let (dir, dist, radiance) = punctual_arrival(&scene.lights[k as usize], p);
@@ -225,7 +194,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
             dir,
             dist,
             radiance,
-            pdf: punctual_pdf(scene, k),
+            pdf: pmf,
             triangle: e.triangle,
         };
     }
@@ -243,7 +212,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, u: Vec3) -> LightSample {
         dir,
         dist,
         radiance: emitted_radiance(scene, e.triangle, b, -dir),
-        pdf: emitter_pdf(scene, e.triangle, dir, dist),
+        pdf: emitter_area_pdf(scene, pmf, e.triangle, dir, dist),
         triangle: e.triangle,
     }
 }

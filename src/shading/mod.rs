@@ -8,6 +8,7 @@ pub mod alpha_pass;
 pub mod bsdf;
 pub mod candidates;
 pub mod gris;
+pub mod light_tree;
 pub mod lights;
 pub mod path_record;
 pub mod ray_offset;

@@ -23,7 +23,7 @@ pub fn random_scene(seed: u64) -> Scene {
 }
 
 /// `random_scene` with three punctual lights (point, spot, directional) beside its emitters.
-fn random_scene_with_punctual_lights(seed: u64) -> Scene {
+pub fn random_scene_with_punctual_lights(seed: u64) -> Scene {
     random_scene_lit(
         seed,
         vec![
@@ -172,6 +172,7 @@ fn params_buffer(scene: &SceneGpu, settings: &RenderSettings) -> Buffer {
 #[derive(Default)]
 struct Coverage {
     hits: usize,
+    light_samples: usize,
     punctual_samples: usize,
     punctual_shadowed: usize,
 }
@@ -179,7 +180,7 @@ struct Coverage {
 /// Runs oracle/scene_oracle.comp (compiled with `defines`) over random rays and compares every
 /// output with the Rust twins.
 fn check_scene_oracle(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, defines: &[(&str, &str)]) {
-    // Punctual lights share the alias table: light sampling's delta branch is compared too.
+    // Punctual lights are chosen beside emissive triangles: light sampling's delta branch is compared too.
     let settings = oracle_settings();
     let params = params_buffer(scene_gpu, &settings);
     let mut r = TestRng(2);
@@ -210,9 +211,11 @@ fn check_scene_oracle(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, d
     }
     let Coverage {
         hits,
+        light_samples,
         punctual_samples,
         punctual_shadowed,
     } = coverage;
+    assert!(light_samples > RAYS / 2, "only {light_samples} of {RAYS} light samples succeeded");
     assert!(
         punctual_samples > RAYS / 20,
         "only {punctual_samples} light samples chose a punctual light: the delta branch is not exercised"
@@ -258,11 +261,11 @@ fn check_traversal(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize, coverage
 /// sample_light, camera_ray_dir and punctual_occluded of item `i` against their Rust twins.
 fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
     let (o, d, u, px) = (input[0], input[1].truncate(), input[2].truncate(), input[3]);
-    let ls = sample_light(scene, o.truncate(), u);
+    let ls = sample_light(scene, o.truncate(), d, u);
     let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
     assert!(
         dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
-        "sample_light direction, item {i}"
+        "sample_light direction, item {i}: {g:?} vs {ls:?}"
     );
     assert!(
         (g[3].truncate() - ls.radiance).abs().max_element() < 1e-4 && close(g[3].w, ls.pdf, 1e-3),
@@ -271,6 +274,17 @@ fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec
     let dir = scene.cameras[0].ray_dir(px.x, px.y, settings.width, settings.height);
     assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
     assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
+    // GLSL's own pdf of its sample, recomputed along the light's bit trail, equals the pdf it
+    // sampled with (what MIS and the shifts rely on), to float rounding.
+    assert!(
+        close(g[5].y, g[3].w, 1e-5),
+        "light_select_pmf / emitter_pdf vs sample pdf, item {i}: {} vs {}",
+        g[5].y,
+        g[3].w
+    );
+    if ls.pdf > 0.0 {
+        coverage.light_samples += 1;
+    }
     if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
         coverage.punctual_samples += 1;
         let shadowed =
@@ -358,7 +372,7 @@ fn environment_map_light_sampling_matches(degrees: f32) {
     let (mut env_samples, mut near_edges) = (0, 0);
     for i in 0..RAYS {
         let (o, u) = (inputs[4 * i].truncate(), inputs[4 * i + 2].truncate());
-        let ls = sample_light(&scene, o, u);
+        let ls = sample_light(&scene, o, inputs[4 * i + 1].truncate(), u);
         let g = &out[6 * i..6 * i + 6];
         assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light choice, item {i}");
         assert!(
@@ -367,7 +381,7 @@ fn environment_map_light_sampling_matches(degrees: f32) {
             g[2].truncate(),
             ls.dir
         );
-        if ls.triangle == NO_EMITTER {
+        if ls.triangle == NO_EMITTER && ls.dist.is_infinite() {
             env_samples += 1;
             if !check_environment_sample(&scene, &ls, g[3], i) {
                 near_edges += 1;

@@ -78,7 +78,7 @@ fn scene_structs() -> Vec<StructLayout> {
         rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, specular, specular_color, pad),
         rust_fields!(Triangle: v0, material, e1, emitter, e2, alpha_tested),
         rust_fields!(BvhNode: lo, skip, hi, leaf),
-        rust_fields!(Emitter: triangle, select_pdf, alias_prob, alias),
+        rust_fields!(Emitter: triangle, trail, intensity, leaf),
         rust_fields!(FrameParams: cam_position, cam_right, cam_up, cam_forward, scene_env, width, height, sample_offset,
             samples_per_dispatch, max_depth, render_seed, flags, emitter_count),
     ]

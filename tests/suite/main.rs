@@ -22,6 +22,7 @@ mod gris_oracle;
 mod gris_temporal_weights;
 mod independent_renderer;
 mod layout;
+mod many_lights;
 mod metal_box_scene;
 mod normal_mapped_scene;
 mod punctual;

@@ -31,7 +31,13 @@ fn path_tracer_image_is_bit_identical_whatever_the_dispatch_split() {
             tracer.dispatch(samples).unwrap();
         }
         let image = tracer.image().unwrap();
-        image.mean.iter().chain(&image.variance).flat_map(|v| v.to_array()).map(f32::to_bits).collect()
+        image
+            .mean
+            .iter()
+            .chain(&image.variance)
+            .flat_map(|v| v.to_array())
+            .map(f32::to_bits)
+            .collect()
     };
     let whole = split(&[12]);
     assert_eq!(whole, split(&[1; 12]), "one sample per dispatch");

@@ -4,10 +4,11 @@
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
+use restir_pt::gpu_types::NO_EMITTER;
 use restir_pt::metrics::{mean, standard_error};
 use restir_pt::scene::bvh::intersect_triangle;
 use restir_pt::shading::bsdf::{ggx_vndf_pdf, smith_g1};
-use restir_pt::shading::lights::{alias_select, sample_light};
+use restir_pt::shading::lights::sample_light;
 use restir_pt::shading::sampling::{sample_cosine_hemisphere, sample_ggx_vndf, sample_triangle};
 
 use crate::common::TestRng;
@@ -142,18 +143,92 @@ fn sample_triangle_chi_square() {
     assert_fits("triangle area sampling", &observed, &expected);
 }
 
+/// Light selection (the light tree's descent and the directional lights beside it) at several
+/// shading points against its own pmf, `light_select_pmf`, which sums to at most 1 over the
+/// lights (the rest: descents where no light below can reach p): chi-square at the 1% level
+/// per point.
 #[test]
-fn light_selection_chi_square_follows_emitter_power() {
-    let scene = crate::bvh_oracle::random_scene(12);
+fn light_selection_chi_square_follows_its_pmf() {
+    use restir_pt::shading::light_tree::{light_select, light_select_pmf};
+    let scene = crate::bvh_oracle::random_scene_with_punctual_lights(12);
+    assert!(scene.directional_count == 1 && scene.light_nodes.len() > 200);
     let n = scene.emitters.len();
-    let mut observed = vec![0.0; n];
+    let keep = 1.0 - scene.env_select_prob as f64;
     let mut r = TestRng(61);
-    for _ in 0..SAMPLES {
-        observed[alias_select(&scene.emitters, r.uniform(), n as u32) as usize] += 1.0;
+    for (p, normal) in [
+        (Vec3::new(0.3, -0.2, 0.1), Vec3::Y),
+        (Vec3::new(-4.0, 4.5, 2.0), Vec3::new(0.6, 0.0, 0.8)),
+        (Vec3::new(6.0, 0.0, -6.0), -Vec3::X),
+    ] {
+        // The last bin: descents that end where no child can reach p (pbrt-v4 fails them too).
+        let mut observed = vec![0.0; n + 1];
+        for _ in 0..SAMPLES / 2 {
+            let (row, pmf) = light_select(&scene, p, normal, r.uniform());
+            assert_eq!(row == NO_EMITTER, pmf == 0.0, "a light drawn with probability 0 at {p}");
+            observed[(row as usize).min(n)] += 1.0;
+        }
+        let mut pmf: Vec<f64> = (0..n as u32)
+            .map(|row| light_select_pmf(&scene, p, normal, row) as f64 / keep)
+            .collect();
+        let total: f64 = pmf.iter().sum();
+        assert!(total < 1.0 + 1e-4 && total > 0.3, "light_select_pmf sums to {total} at {p}");
+        eprintln!("light selection at {p}: the pmf sums to {total:.4} (the rest: dead ends)");
+        pmf.push((1.0 - total).max(0.0));
+        let expected: Vec<f64> = pmf.iter().map(|q| q * (SAMPLES / 2) as f64).collect();
+        assert_fits(&format!("light selection at {p}"), &observed, &expected);
     }
-    let expected: Vec<f64> = scene.emitters.iter().map(|e| e.select_pdf as f64 * SAMPLES as f64).collect();
-    assert!((scene.emitters.iter().map(|e| e.select_pdf as f64).sum::<f64>() - 1.0).abs() < 1e-5);
-    assert_fits("alias-table emitter selection", &observed, &expected);
+}
+
+/// The pmf light sampling draws a light with equals the one `light_select_pmf` recomputes along
+/// the light's bit trail, bit for bit (the shifts and MIS rely on it), and `sample_light`'s pdf
+/// equals `emitter_pdf`'s (or, for a punctual light, `light_select_pmf`'s) to float rounding,
+/// at 2×10^5 random shading points, normals and uniforms of the scene with every kind of light
+/// (measured: 180363 lights drawn, 38523 samples on triangles).
+#[test]
+fn light_select_pmf_recomputes_the_sampled_pmf_exactly() {
+    use restir_pt::shading::light_tree::{light_select, light_select_pmf};
+    use restir_pt::shading::lights::{emitter_pdf, is_punctual_light, punctual_emitter_row};
+    let scene = crate::bvh_oracle::random_scene_with_punctual_lights(14);
+    let mut r = TestRng(81);
+    let (mut drawn, mut triangles) = (0, 0);
+    for i in 0..200_000 {
+        let p = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 12.0 - 6.0;
+        let n = r.unit_vector();
+        let (row, pmf) = light_select(&scene, p, n, r.uniform());
+        if row == NO_EMITTER {
+            continue;
+        }
+        drawn += 1;
+        assert_eq!(
+            light_select_pmf(&scene, p, n, row).to_bits(),
+            pmf.to_bits(),
+            "draw {i}: row {row} at {p}"
+        );
+        let ls = sample_light(&scene, p, n, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
+        if !(ls.pdf > 0.0) || ls.triangle == NO_EMITTER {
+            continue;
+        }
+        let again = if is_punctual_light(ls.triangle) {
+            light_select_pmf(
+                &scene,
+                p,
+                n,
+                punctual_emitter_row(&scene, ls.triangle & !restir_pt::gpu_types::PUNCTUAL_LIGHT_BIT),
+            )
+        } else {
+            triangles += 1;
+            emitter_pdf(&scene, p, n, ls.triangle, ls.dir, ls.dist)
+        };
+        assert!(
+            (again - ls.pdf).abs() <= 1e-5 * ls.pdf,
+            "sample {i}: pdf {} recomputed as {again}",
+            ls.pdf
+        );
+    }
+    assert!(
+        drawn > 150_000 && triangles > 30_000,
+        "{drawn} lights drawn, {triangles} triangle samples"
+    );
 }
 
 /// E[1 / pdf] over light samples equals the total solid angle the emitters subtend (each
@@ -168,7 +243,7 @@ fn sample_light_pdf_is_consistent_with_solid_angle() {
     let n = 400_000;
     let light: Vec<f64> = (0..n)
         .map(|_| {
-            let ls = sample_light(&scene, p, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
+            let ls = sample_light(&scene, p, Vec3::Y, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
             if ls.pdf > 0.0 {
                 1.0 / ls.pdf as f64
             } else {
@@ -176,7 +251,12 @@ fn sample_light_pdf_is_consistent_with_solid_angle() {
             }
         })
         .collect();
-    let emitters: Vec<_> = scene.emitters.iter().map(|e| scene.triangles[e.triangle as usize]).collect();
+    // Light sampling reaches every emitter whose selection probability at p is positive.
+    let emitters: Vec<_> = (0..scene.emitters.len() as u32)
+        .filter(|&row| restir_pt::shading::light_tree::light_select_pmf(&scene, p, Vec3::Y, row) > 0.0)
+        .map(|row| scene.triangles[scene.emitters[row as usize].triangle as usize])
+        .collect();
+    assert!(emitters.len() > 20, "{} emitters reachable", emitters.len());
     let sphere: Vec<f64> = (0..n)
         .map(|_| {
             let d = r.unit_vector();

@@ -174,7 +174,7 @@ pub(super) fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32,
 /// The light point NEE at x_i chooses with the path's random numbers, and its light sample;
 /// `None` if none can be chosen. Visibility is left to the caller.
 pub(crate) fn nee_vertex(scene: &Scene, x: &Vertex, seed: u32, i: usize) -> Option<(LightSample, Vertex)> {
-    let ls = sample_light(scene, x.pos, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate());
+    let ls = sample_light(scene, x.pos, x.normal, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate());
     if !(ls.pdf > 0.0) {
         return None;
     }

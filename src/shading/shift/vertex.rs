@@ -9,9 +9,10 @@ use crate::scene::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT}
 use crate::scene::PunctualKind;
 use crate::scene::Scene;
 use crate::shading::bsdf::{bsdf_eval_pdf, has_specular_layer, index_matched, lobe_weights, DELTA_ALPHA};
+use crate::shading::light_tree::light_select_pmf;
 use crate::shading::lights::{
-    emitted_radiance, emitter_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_occluded,
-    punctual_pdf,
+    emitted_radiance, emitter_area_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_emitter_row,
+    punctual_occluded,
 };
 use crate::shading::ray_offset::offset_ray_origin;
 use crate::shading::sampling::balance_heuristic;
@@ -192,17 +193,27 @@ pub(crate) fn end_emission(scene: &Scene, from: &Vertex, end: &Vertex) -> Vec3 {
     emitted_radiance(scene, end.triangle, triangle_bary(tri, end.pos), (from.pos - end.pos).normalize())
 }
 
-/// Solid-angle pdf that NEE at `from` picks `end`; for a punctual light the discrete probability
-/// of choosing it.
+/// The pdf that NEE at `from` picks `end` (solid angle); for a punctual light the discrete
+/// probability of choosing it. Twin of GLSL `light_pdf`.
 pub(super) fn light_pdf(scene: &Scene, from: &Vertex, end: &Vertex) -> f32 {
-    if vertex_is_punctual(end) {
-        return punctual_pdf(scene, vertex_light(end));
-    }
     let (dir, dist) = direction(scene, from, end);
     if vertex_is_escaped(end) {
-        environment_pdf(scene, dir)
+        return environment_pdf(scene, dir);
+    }
+    let punctual = vertex_is_punctual(end);
+    let row = if punctual {
+        punctual_emitter_row(scene, vertex_light(end))
     } else {
-        emitter_pdf(scene, end.triangle, dir, dist)
+        scene.triangles[end.triangle as usize].emitter
+    };
+    if row == NO_EMITTER {
+        return 0.0;
+    }
+    let pmf = light_select_pmf(scene, from.pos, from.normal, row);
+    if punctual {
+        pmf
+    } else {
+        emitter_area_pdf(scene, pmf, end.triangle, dir, dist)
     }
 }
 
