@@ -18,7 +18,7 @@
 use glam::{Vec2, Vec3};
 
 use super::bvh::{trace_closest, NO_HIT};
-use super::{luminance, PunctualKind, Scene, DEFAULT_ENVIRONMENT};
+use super::{luminance, PunctualKind, PunctualLight, Scene, DEFAULT_ENVIRONMENT};
 use crate::gpu_types::NO_EMITTER;
 use crate::shading::ray_offset::offset_ray_origin;
 use crate::shading::sampling::{build_onb, sample_cosine_hemisphere, sample_triangle, sample_uniform_sphere};
@@ -38,8 +38,24 @@ enum Source {
     Punctual(usize),
 }
 
+/// Emitted power (luminance-weighted) of a punctual light: 4πI for a point light, the solid
+/// angle of the cone halfway between the inner and outer angles times I for a spot, and I times
+/// the area of the scene's bounding disc (radius `scene_radius`) for a directional light (as
+/// pbrt-v4's `DistantLight::Phi`).
+fn punctual_power(light: &PunctualLight, scene_radius: f32) -> f32 {
+    let i = luminance(light.intensity);
+    match light.kind {
+        PunctualKind::Point => 4.0 * std::f32::consts::PI * i,
+        PunctualKind::Spot => {
+            let cos_mid = 0.5 * (light.cos_inner + light.cos_outer);
+            2.0 * std::f32::consts::PI * (1.0 - cos_mid) * i
+        }
+        PunctualKind::Directional => std::f32::consts::PI * scene_radius * scene_radius * i,
+    }
+}
+
 /// The share of the lights' power (emissive triangles by emission × area, punctual lights by
-/// [`super::PunctualLight::power`]) whose first ray leaves the scene without hitting anything:
+/// `punctual_power`) whose first ray leaves the scene without hitting anything:
 /// 4096 rays, the light chosen by power, a uniform point on a triangle and a cosine-distributed
 /// direction on an emitting side, a uniform direction of a point light's sphere or a spot's
 /// cone. Directional lights count as leaving (they come from outside the scene). Deterministic;
@@ -60,7 +76,7 @@ pub fn light_escape_fraction(scene: &Scene) -> f32 {
         cumulative.push(total);
     }
     for (k, light) in scene.lights.iter().enumerate() {
-        total += light.power(scene_radius) as f64;
+        total += punctual_power(light, scene_radius) as f64;
         sources.push(Source::Punctual(k));
         cumulative.push(total);
     }

@@ -452,6 +452,7 @@ fn restir_unbiased_many_lights() {
         reservoirs: 1,
         path_tracer_control: true,
         static_camera: false,
+        frames: FRAMES,
         configurations: EVERY_SHIFT,
         base: RestirSettings::default(),
     });
