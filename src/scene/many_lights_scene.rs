@@ -23,6 +23,11 @@ fn jitter(i: usize, k: u32) -> f32 {
     (h >> 8) as f32 / (1u32 << 24) as f32
 }
 
+/// A dim, constant night sky written into the file (extras.environment): a scene lit by a sun
+/// would otherwise get a viewer's default sky of radiance 1 (default_environment.rs), which would
+/// outshine the lamps this scene exists to test.
+const NIGHT_SKY: Vec3 = Vec3::new(0.02, 0.025, 0.035);
+
 /// Scene 10: a 24 x 24 ground with four blocks, lit by a hundred small lamps on a jittered 10 x
 /// 10 grid 0.5 to 1.3 above it (80 emissive panels of 0.15 x 0.15 facing down, 20 point lights)
 /// and a low sun (1 lux) that casts the blocks' shadows across the lamp pools.
@@ -79,5 +84,5 @@ pub fn many_lights() -> String {
             0.9,
         );
     }
-    b.finish("many-lights", Vec3::ZERO)
+    b.finish("many-lights", NIGHT_SKY)
 }

@@ -9,11 +9,11 @@
 use glam::{Vec2, Vec3};
 use restir_pt::render::{Image, PathTracer, RenderSettings, SceneGpu};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
-use restir_pt::scene::{load_scene, Scene};
+use restir_pt::scene::{load_scene_from_bytes_with_options, LoadOptions, Scene};
 use restir_pt::shading::lights::spot_falloff;
 use serde_json::{json, Value};
 
-use crate::common::{assert_clean, gpu, temp_file};
+use crate::common::{assert_clean, gpu};
 use crate::restir_unbiased::luminance;
 
 const ALBEDO: f32 = 0.5;
@@ -34,7 +34,17 @@ fn lamp_scene(name: &str, ground: f32, extra: &[(Value, Vec3, Vec3)]) -> Scene {
         b.punctual_light(light.clone(), *position, *direction);
     }
     b.camera("camera", Vec3::new(0.0, 2.0, 1.2), Vec3::ZERO, 0.7);
-    load_scene(&temp_file(name, b.finish(name, Vec3::ZERO).as_bytes())).unwrap()
+    without_default_sky(name, &b.finish(name, Vec3::ZERO))
+}
+
+/// The scene of glTF `text` lit by its lights alone: a sun would otherwise bring the viewer's
+/// default sky (src/scene/default_environment.rs), whose noise is not the lamps'.
+fn without_default_sky(name: &str, text: &str) -> Scene {
+    let options = LoadOptions {
+        no_environment: true,
+        ..Default::default()
+    };
+    load_scene_from_bytes_with_options(text.as_bytes(), None, std::path::Path::new(name), &options).unwrap()
 }
 
 fn path_traced(scene: &Scene, side: u32, spp: u32, max_depth: u32) -> Image {
@@ -152,7 +162,7 @@ fn many_light_scene() -> ManyLights {
         Vec3::new(0.5, -1.0, 0.3),
     );
     b.camera("camera", Vec3::new(0.0, 4.5, 2.5), Vec3::new(0.0, 0.0, -0.3), 0.9);
-    let scene = load_scene(&temp_file("many-lights-test.gltf", b.finish("many lights", Vec3::ZERO).as_bytes())).unwrap();
+    let scene = without_default_sky("many-lights-test.gltf", &b.finish("many lights", Vec3::ZERO));
     ManyLights { scene, panels }
 }
 
