@@ -205,7 +205,7 @@ fn light_select_pmf_recomputes_the_sampled_pmf_exactly() {
             "draw {i}: row {row} at {p}"
         );
         let ls = sample_light(&scene, p, n, Vec3::new(r.uniform(), r.uniform(), r.uniform()));
-        if !(ls.pdf > 0.0) || ls.triangle == NO_EMITTER {
+        if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.triangle == NO_EMITTER {
             continue;
         }
         let again = if is_punctual_light(ls.triangle) {
