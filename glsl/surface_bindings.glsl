@@ -66,10 +66,27 @@ const uint ALPHA_OPAQUE = 0u;
 const uint ALPHA_MASK = 1u;
 const uint ALPHA_BLEND = 2u;
 
+#ifndef SCENE_ADDRESSED
+#define SCENE_ADDRESSED 0
+#endif
+#if SCENE_ADDRESSED && (SCENE_SURFACE || SCENE_TEXTURES)
+// In the addressed layout (glsl/scene_bindings.glsl) the attributes (144 bytes a triangle, the
+// largest per-triangle array) and the texels are reached by device address too: their bindings
+// hold the address and the element count, and the names below keep their meaning.
+#extension GL_EXT_buffer_reference : require
+#endif
 #if SCENE_SURFACE
+#if SCENE_ADDRESSED
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer TriangleSurfaceArray { TriangleSurface items[]; };
+layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_SURFACE_ATTRIBUTES) readonly buffer SurfaceAttributes {
+    TriangleSurfaceArray surface_attribute_array;
+};
+#define surface_attributes (surface_attribute_array.items)
+#else
 layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_SURFACE_ATTRIBUTES) readonly buffer SurfaceAttributes {
     TriangleSurface surface_attributes[];
 };
+#endif
 #endif
 #if SCENE_TEXTURES
 layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_MATERIAL_TEXTURE_TABLE) readonly buffer MaterialTextureTable {
@@ -79,7 +96,13 @@ layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_TE
     TextureHeader texture_headers[];
 };
 // RGBA8 texels, R in the low byte.
+#if SCENE_ADDRESSED
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer TexelArray { uint items[]; };
+layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_TEXELS) readonly buffer Texels { TexelArray texel_array; };
+#define texels (texel_array.items)
+#else
 layout(std430, set = SURFACE_SET, binding = SURFACE_BINDING + SURFACE_BINDING_TEXELS) readonly buffer Texels { uint texels[]; };
+#endif
 #endif
 
 #endif

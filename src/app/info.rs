@@ -108,6 +108,7 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
     if let Some(line) = scene.surface_summary() {
         println!("{line}");
     }
+    println!("{}", array_summary(scene));
     println!(
         "emitters: {} triangles, power {:.4} (luminance W); light tree: {} nodes",
         scene.emitters.len() - scene.lights.len(),
@@ -175,6 +176,30 @@ fn print_scene(path: &Path, scene: &Scene, load_ms: f64) {
     }
 }
 
+/// The sizes of the scene's per-triangle and per-node device arrays, and what happens to an
+/// array past one storage binding: scenes with one are reached by device address
+/// (`SceneGpu::addressed`), each array then bounded by maxMemoryAllocationSize.
+fn array_summary(scene: &Scene) -> String {
+    let mib = |bytes: usize| bytes as f64 / (1024.0 * 1024.0);
+    let arrays = [
+        ("triangles", std::mem::size_of_val(scene.triangles.as_slice())),
+        ("BVH nodes", std::mem::size_of_val(scene.nodes.as_slice())),
+        ("vertex attributes", std::mem::size_of_val(scene.surfaces.as_slice())),
+        ("texels", std::mem::size_of_val(scene.textures.texels.as_slice())),
+    ];
+    let parts: Vec<String> = arrays
+        .iter()
+        .map(|(name, bytes)| format!("{name} {:.2} MiB", mib(*bytes)))
+        .collect();
+    let largest = arrays.iter().map(|a| a.1).max().unwrap_or(0);
+    format!(
+        "device arrays: {}; the largest ({:.2} MiB) {} one storage binding of 128 MiB (lavapipe's maxStorageBufferRange; past it the arrays are reached by device address, each up to maxMemoryAllocationSize)",
+        parts.join(", "),
+        mib(largest),
+        if largest as u64 > 1 << 27 { "exceeds" } else { "fits" }
+    )
+}
+
 /// `x` to 4 significant digits, written as briefly as that value allows (3.9000000953674316
 /// prints 3.9, 11.999994 prints 12, -0 prints 0): the file's values as a person wrote them.
 fn round_for_people(x: f64) -> String {
@@ -207,5 +232,20 @@ mod tests {
         assert_eq!(round_for_people(-1.23456e-7), "-0.0000001235");
         assert_eq!(round_for_people(f64::INFINITY), "inf");
         assert_eq!(rounded([17.0f32, 11.999994, 3.999998]), "[17, 12, 4]");
+    }
+
+    /// 110 instanced spheres with normals and UVs: 992,640 triangles, whose 144-byte vertex
+    /// attributes (142,940,160 bytes) are the largest array and pass one 128 MiB binding.
+    #[test]
+    fn info_array_summary_names_the_largest_array_past_one_binding() {
+        use restir_pt::scene::bundled_scenes::instanced_spheres;
+        let text = instanced_spheres(11, 10);
+        let scene = restir_pt::scene::load_scene_from_bytes(text.as_bytes(), None, Path::new("s.gltf")).unwrap();
+        let line = array_summary(&scene);
+        let expected = format!(
+            "device arrays: triangles 45.44 MiB, BVH nodes {:.2} MiB, vertex attributes 136.32 MiB, texels 0.00 MiB; the largest (136.32 MiB) exceeds one storage binding",
+            (scene.nodes.len() * 32) as f64 / (1024.0 * 1024.0)
+        );
+        assert!(line.starts_with(&expected), "{line}");
     }
 }

@@ -3,9 +3,10 @@
 //! Renderers are built from an `Arc<SceneGpu>` and share it, so one upload serves every method.
 //!
 //! Three layouts, chosen by size: uniform buffers (CPU devices, small scenes), storage buffers,
-//! and, when the triangles, BVH nodes or emitters exceed one binding's range
-//! (`DeviceInfo::scene_binding_limit`), those three arrays in buffers reached by device address,
-//! with bindings 1, 2 and 4 holding each one's address and length (`SCENE_ADDRESSED`).
+//! and, when the triangles, BVH nodes, emitters, surface attributes or texels exceed one
+//! binding's range (`DeviceInfo::scene_binding_limit`), those five arrays in buffers reached by
+//! device address, with their bindings (1, 2 and 4 of set 0; the attributes' and texels' of
+//! set 1) holding each one's address and length (`SCENE_ADDRESSED`).
 
 use std::sync::Arc;
 
@@ -51,7 +52,7 @@ pub struct SceneGpu {
 
 /// The 16 bytes of a binding that points at an addressed array: its device address (a
 /// GL_EXT_buffer_reference, 8 bytes at offset 0 under std430) and its element count.
-fn address_record(ctx: &Arc<Context>, name: &str, array: &Buffer, length: usize) -> Result<Buffer, GpuError> {
+pub(super) fn address_record(ctx: &Arc<Context>, name: &str, array: &Buffer, length: usize) -> Result<Buffer, GpuError> {
     let address = array.device_address();
     let record = [address as u32, (address >> 32) as u32, length as u32, 0];
     let buffer = Buffer::new(ctx, name, std::mem::size_of_val(&record) as u64, BufferUsage::Params)?;
@@ -82,11 +83,17 @@ impl SceneGpu {
             std::mem::size_of_val(scene.materials.as_slice()),
             std::mem::size_of_val(emitter_rows.as_slice()),
         ];
-        // Materials stay bound: a binding holds millions of them.
+        // Materials, texture headers and the material texture table stay bound: a binding
+        // holds millions of them.
         let [tri_bytes, node_bytes, _, emitter_bytes] = arrays;
+        let surface_bytes = [
+            std::mem::size_of_val(scene.surfaces.as_slice()),
+            std::mem::size_of_val(scene.textures.texels.as_slice()),
+        ];
         let addressed = ctx.info.buffer_device_address
             && [tri_bytes, node_bytes, emitter_bytes]
                 .iter()
+                .chain(&surface_bytes)
                 .any(|&bytes| bytes as u64 > ctx.info.scene_binding_limit);
         // Divergent uniform-buffer indexing serialises on GPUs; on llvmpipe it beats storage loads.
         let uniform = !addressed
@@ -139,7 +146,7 @@ impl SceneGpu {
             emitters,
             uniform,
             addresses,
-            surface: SurfaceGpu::upload(ctx, scene)?,
+            surface: SurfaceGpu::upload(ctx, scene, addressed)?,
             defines,
         }))
     }
@@ -154,7 +161,8 @@ impl SceneGpu {
         &self.info
     }
 
-    /// Whether the triangles, nodes and emitters are reached by device address.
+    /// Whether the triangles, nodes, emitters, surface attributes and texels are reached by
+    /// device address.
     pub fn addressed(&self) -> bool {
         self.addresses.is_some()
     }

@@ -462,3 +462,26 @@ pub fn tiled_floor(levels: u32) -> String {
     text.push('\n');
     text
 }
+
+/// Triangles of one sphere of [`instanced_spheres`].
+pub const INSTANCED_SPHERE_TRIANGLES: usize = 2 * 96 * 47;
+
+/// A `columns` x `rows` grid (x, z; spacing 1) of one sphere of radius 0.45 with vertex normals
+/// and texture coordinates ([`INSTANCED_SPHERE_TRIANGLES`] triangles), drawn once per grid cell
+/// by `EXT_mesh_gpu_instancing`, under a uniform environment: a scene whose 144-byte vertex
+/// attributes per triangle pass one binding at 110 instances (143 MB) in a file of 0.35 MB, as
+/// instanced exports (Blender's) do.
+pub fn instanced_spheres(columns: u32, rows: u32) -> String {
+    let mut b = GltfBuilder::default();
+    let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.6)));
+    let (mesh, normals, uv) = crate::scene::gltf_writer::textured_sphere(Vec3::ZERO, 0.45, 48, 96);
+    let sphere = b.mesh_with_attributes("sphere", &mesh, Some(&normals), &[&uv], grey);
+    let cells: Vec<Vec3> = (0..rows)
+        .flat_map(|z| (0..columns).map(move |x| Vec3::new(x as f32, 0.0, z as f32)))
+        .collect();
+    b.instanced("spheres", sphere, &cells);
+    let (w, d) = (columns as f32 - 1.0, rows as f32 - 1.0);
+    let centre = Vec3::new(w / 2.0, 0.0, d / 2.0);
+    b.camera("camera", centre + Vec3::new(0.0, 0.8 * w.max(d) + 2.0, 0.6 * d + 2.0), centre, 0.9);
+    b.finish("instanced spheres", Vec3::ONE)
+}

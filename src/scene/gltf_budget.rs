@@ -6,8 +6,10 @@ use anyhow::{bail, Result};
 
 use super::gltf_loader::{problem, Loader, MAX_NODE_DEPTH, MAX_NODE_INSTANCES};
 use crate::gpu_types::Triangle;
+use crate::shading::surface::TriangleSurface;
 
-/// The most bytes the device lets one scene array (the triangles, the largest) take, and the
+/// The most bytes the device lets one scene array (the surface attributes or, without them, the
+/// triangles: the largest) take, and the
 /// limit's Vulkan name for messages: maxStorageBufferRange when arrays are bound,
 /// maxMemoryAllocationSize when they are reached by device address
 /// (`crate::vk::Context::scene_array_limit`).
@@ -70,18 +72,41 @@ impl Loader<'_> {
         total
     }
 
-    /// Fails if the estimated triangles would not fit one array of `limit`.
+    /// Whether the file's triangles may carry vertex attributes (normals, tangents, texture
+    /// coordinates, colours) or textures, so that the scene gets a [`TriangleSurface`] per
+    /// triangle, its largest per-triangle array.
+    fn has_surface_attributes(&self) -> bool {
+        use gltf::Semantic;
+        self.doc.textures().next().is_some()
+            || self.doc.meshes().flat_map(|m| m.primitives()).any(|p| {
+                p.attributes().any(|(s, _)| {
+                    matches!(
+                        s,
+                        Semantic::Normals | Semantic::Tangents | Semantic::TexCoords(_) | Semantic::Colors(_)
+                    )
+                })
+            })
+    }
+
+    /// Fails if the estimated triangles' largest per-triangle array (the [`TriangleSurface`]
+    /// attributes if the file has any, else the [`Triangle`] records) would not fit one array
+    /// of `limit`.
     pub(super) fn check_array_budget(&self, scene: &gltf::Scene, limit: ArrayLimit) -> Result<()> {
         let estimate = self.estimate_triangles(scene);
-        let bytes = estimate as u64 * std::mem::size_of::<Triangle>() as u64;
+        let (record, array) = if self.has_surface_attributes() {
+            (std::mem::size_of::<TriangleSurface>() as u64, "vertex attributes")
+        } else {
+            (std::mem::size_of::<Triangle>() as u64, "triangles")
+        };
+        let bytes = estimate as u64 * record;
         if bytes > limit.bytes {
             bail!(problem(
                 self.path,
                 format!(
-                    "about {estimate} triangles need {bytes} bytes in one buffer, more than the device allows ({} bytes, {}; at most {} triangles)",
+                    "about {estimate} triangles' {array} need {bytes} bytes in one buffer, more than the device allows ({} bytes, {}; at most {} triangles)",
                     limit.bytes,
                     limit.name,
-                    limit.bytes / std::mem::size_of::<Triangle>() as u64
+                    limit.bytes / record
                 )
             ));
         }

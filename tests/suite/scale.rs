@@ -2,7 +2,8 @@
 //! triangles) reach their triangles, BVH nodes and emitters by buffer device address
 //! (SCENE_ADDRESSED in glsl/scene_bindings.glsl). A lowered `ContextOptions::scene_binding_limit`
 //! sends small scenes down that path, so that whole renders compare it with the bound layout at
-//! test size; one scene really past the limit renders too. The oracles of the addressed path are
+//! test size; scenes really past the limit (triangles; vertex attributes) render too. The
+//! vertex attributes and texels take the same path (`SurfaceGpu`). The oracles of the addressed path are
 //! in bvh_oracle.rs and trace_pair_oracle.rs.
 
 use std::path::Path;
@@ -10,7 +11,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use restir_pt::render::{Image, PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
-use restir_pt::scene::bundled_scenes::{cornell_sphere, tiled_floor, TILE_TRIANGLES};
+use restir_pt::scene::bundled_scenes::{cornell_sphere, instanced_spheres, tiled_floor, INSTANCED_SPHERE_TRIANGLES, TILE_TRIANGLES};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
 
 use crate::common::{assert_clean, gpu, gpu_with_scene_binding_limit};
@@ -65,20 +66,44 @@ fn assert_bit_identical(what: &str, bound: &Image, addressed: &Image) {
 /// images equal the storage-buffer layout's bit for bit.
 #[test]
 fn scale_addressed_layout_renders_the_images_of_the_bound_layout() {
-    let scene = sphere_scene();
+    assert_addressed_renders_as_bound(&sphere_scene(), true);
+}
+
+/// The same with vertex attributes and textures, whose arrays (`SurfaceGpu`) are addressed too:
+/// the normal-mapped box (interpolated normals, tangents, texture coordinates, normal maps),
+/// path traced. ReSTIR PT reads the attributes and texels through the same names of
+/// glsl/surface_bindings.glsl; its four textured kernels, compiled in both layouts, would add
+/// minutes of llvmpipe compilation on a cold shader cache.
+#[test]
+fn scale_addressed_surface_attributes_and_texels_render_the_images_of_the_bound_layout() {
+    let scene = crate::normal_mapped_scene::normal_mapped_box();
+    assert!(!scene.surfaces.is_empty() && !scene.textures.texels.is_empty());
+    assert_addressed_renders_as_bound(&scene, false);
+}
+
+/// Renders `scene` with its arrays bound (storage buffers) and addressed (a lowered binding
+/// limit) and requires the two images of the path tracer, and with `restir` of ReSTIR PT, to
+/// be equal bit for bit.
+fn assert_addressed_renders_as_bound(scene: &Scene, restir: bool) {
     let bound_ctx = gpu();
     let addressed_ctx = gpu_with_scene_binding_limit(Some(TINY_LIMIT));
-    let bound_scene = SceneGpu::upload(&bound_ctx, &scene).unwrap();
-    let addressed_scene = SceneGpu::upload(&addressed_ctx, &scene).unwrap();
-    let layout = |g: &SceneGpu| (g.uniform, g.addressed());
-    assert_eq!(layout(&bound_scene), (false, false), "the bound run must use storage buffers");
-    assert_eq!(layout(&addressed_scene), (false, true), "the lowered limit must address the arrays");
+    let bound_scene = SceneGpu::upload(&bound_ctx, scene).unwrap();
+    let addressed_scene = SceneGpu::upload(&addressed_ctx, scene).unwrap();
+    let surface = |g: &SceneGpu| g.surface.as_ref().map(|s| s.addressed());
+    let has_surface = (!scene.surfaces.is_empty()).then_some(false);
+    assert!(!bound_scene.addressed(), "the bound run must bind the arrays");
+    assert_eq!(surface(&bound_scene), has_surface);
+    assert!(!addressed_scene.uniform);
+    assert!(addressed_scene.addressed(), "the lowered limit must address the arrays");
+    assert_eq!(surface(&addressed_scene), has_surface.map(|_| true));
     let bound = path_traced(&bound_scene);
     let addressed = path_traced(&addressed_scene);
     assert_bit_identical("path tracer", &bound, &addressed);
-    let bound = restir_frames(&bound_scene);
-    let addressed = restir_frames(&addressed_scene);
-    assert_bit_identical("ReSTIR PT", &bound, &addressed);
+    if restir {
+        let bound = restir_frames(&bound_scene);
+        let addressed = restir_frames(&addressed_scene);
+        assert_bit_identical("ReSTIR PT", &bound, &addressed);
+    }
     assert_clean(&bound_ctx);
     assert_clean(&addressed_ctx);
 }
@@ -112,5 +137,44 @@ fn scale_scene_past_one_binding_renders() {
     // camera rays that miss it read exactly 1, those that hit it almost never do.
     let floor = image.mean.iter().filter(|p| **p != glam::Vec3::ONE).count();
     assert!(floor >= 16, "only {floor} of 64 pixels see the floor: traversal missed it");
+    assert_clean(&ctx);
+}
+
+/// 992,640 triangles with vertex normals and texture coordinates (a sphere instanced 110 times by
+/// EXT_mesh_gpu_instancing): 143 MB of vertex attributes, past lavapipe's 128 MiB per binding,
+/// while the triangles (48 MB) fit one. The scene takes the addressed layout, attributes
+/// included, and renders a finite image in which the spheres are seen.
+#[test]
+fn scale_vertex_attributes_past_one_binding_render() {
+    let ctx = gpu();
+    let text = instanced_spheres(11, 10);
+    let scene = load_scene_from_bytes(text.as_bytes(), None, Path::new("instanced-spheres.gltf")).unwrap();
+    assert_eq!(scene.triangles.len(), 110 * INSTANCED_SPHERE_TRIANGLES);
+    let bytes = std::mem::size_of_val(scene.surfaces.as_slice()) as u64;
+    assert_eq!(bytes, 142_940_160);
+    if bytes <= ctx.info.max_storage_buffer_range {
+        eprintln!("this device binds {bytes} bytes at once; nothing to test");
+        return;
+    }
+    assert!(ctx.info.buffer_device_address, "the device lacks bufferDeviceAddress");
+    let settings = RenderSettings {
+        width: 16,
+        height: 16,
+        spp: 1,
+        ..Default::default()
+    };
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(scene_gpu.addressed() && scene_gpu.surface.as_ref().unwrap().addressed());
+    let mut tracer = PathTracer::new(&scene_gpu, &settings).unwrap();
+    let stats = tracer.render(&|_| {}, &AtomicBool::new(false)).unwrap();
+    let image = tracer.image().unwrap();
+    drop(tracer);
+    drop(scene_gpu);
+    assert_eq!(stats.nonfinite_paths, 0);
+    assert_eq!(image.non_finite_count(), 0);
+    // Grey spheres (albedo 0.6) under a white sky (radiance 1): rays that miss read exactly 1,
+    // those that hit a sphere almost never do.
+    let spheres = image.mean.iter().filter(|p| **p != glam::Vec3::ONE).count();
+    assert!(spheres >= 64, "only {spheres} of 256 pixels see a sphere: traversal missed them");
     assert_clean(&ctx);
 }

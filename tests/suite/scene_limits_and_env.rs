@@ -59,6 +59,39 @@ fn real_scenes_array_limit_is_checked_from_accessor_counts_before_loading() {
     }
 }
 
+/// A file with vertex normals and UVs gets 144 bytes of attributes per triangle, its largest
+/// array: the estimate counts those (EXT_mesh_gpu_instancing copies included), so that a scene
+/// whose 48-byte triangles would fit but whose attributes would not is refused before loading.
+#[test]
+fn gltf_budget_counts_the_vertex_attributes_of_instanced_meshes() {
+    use restir_pt::scene::bundled_scenes::{instanced_spheres, INSTANCED_SPHERE_TRIANGLES};
+    use restir_pt::scene::ArrayLimit;
+    let path = crate::common::temp_file("spheres.gltf", instanced_spheres(2, 1).as_bytes());
+    let triangles = 2 * INSTANCED_SPHERE_TRIANGLES;
+    let load = |bytes| {
+        let options = LoadOptions {
+            array_limit: Some(ArrayLimit {
+                bytes,
+                name: "maxMemoryAllocationSize",
+            }),
+            ..Default::default()
+        };
+        load_scene_reporting(&path, &options, &mut Vec::new()).map_err(|e| format!("{e:#}"))
+    };
+    let attribute_bytes = (triangles * 144) as u64;
+    let scene = load(attribute_bytes).unwrap();
+    assert_eq!(scene.triangles.len(), triangles);
+    assert_eq!(std::mem::size_of_val(scene.surfaces.as_slice()) as u64, attribute_bytes);
+    for limit in [attribute_bytes - 1, (triangles * 48) as u64] {
+        let e = load(limit).err().unwrap();
+        let expected = format!(
+            "spheres.gltf: about {triangles} triangles' vertex attributes need {attribute_bytes} bytes in one buffer, more than the device allows ({limit} bytes, maxMemoryAllocationSize; at most {} triangles)",
+            limit / 144
+        );
+        assert!(e.ends_with(&expected) && !e.contains('\n'), "{e}");
+    }
+}
+
 #[test]
 fn real_scenes_env_file_loads_exr_and_hdr_and_renders_with_both_methods() {
     let map = crate::sampling_statistics::test_environment_map();

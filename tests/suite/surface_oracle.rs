@@ -155,7 +155,18 @@ fn near_texel_edge(h: &TextureHeader, uv: Vec2) -> bool {
 
 #[test]
 fn surface_at_texture_lookup_textured_material_normal_mapped_glsl_matches_rust() {
-    compare_surfaces(&textured_random_scene(7));
+    compare_surfaces(&gpu(), &textured_random_scene(7));
+}
+
+/// The same comparison with the attributes and texels reached by device address (a lowered
+/// binding limit sends the scene down the path of scenes past one binding).
+#[test]
+fn surface_at_texture_lookup_textured_material_normal_mapped_glsl_matches_rust_addressed() {
+    let ctx = crate::common::gpu_with_scene_binding_limit(Some(4096));
+    let scene = textured_random_scene(7);
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    assert!(scene_gpu.addressed() && scene_gpu.surface.as_ref().unwrap().addressed());
+    compare_surfaces(&ctx, &scene);
 }
 
 /// The same comparison on the public Avocado sample: three 2048x2048 textures (48 MiB of
@@ -169,16 +180,15 @@ fn surface_oracle_on_the_avocado_sample() {
     }
     let scene = restir_pt::scene::load_scene(&path).unwrap();
     assert_eq!(scene.textures.headers.len(), 3);
-    compare_surfaces(&scene);
+    compare_surfaces(&gpu(), &scene);
 }
 
 /// Runs surface_oracle.comp over random hits of `scene` and compares each output with its
 /// Rust twin.
-fn compare_surfaces(scene: &Scene) {
-    let ctx = gpu();
-    let scene_gpu = SceneGpu::upload(&ctx, scene).unwrap();
+fn compare_surfaces(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene) {
+    let scene_gpu = SceneGpu::upload(ctx, scene).unwrap();
     let inputs = random_hits(scene);
-    let out = run_surface_oracle(&ctx, &scene_gpu, &inputs);
+    let out = run_surface_oracle(ctx, &scene_gpu, &inputs);
     let (mut skipped, mut compared) = (0, 0);
     for i in 0..ITEMS {
         if check_item(scene, &inputs[3 * i..3 * i + 3], &out[ROWS * i..ROWS * i + ROWS], i) {
@@ -189,7 +199,7 @@ fn compare_surfaces(scene: &Scene) {
     }
     assert!(skipped < ITEMS / 20, "{skipped} of {ITEMS} items near a nearest-filter texel edge");
     assert!(compared > 0);
-    assert_clean(&ctx);
+    assert_clean(ctx);
 }
 
 /// Three vec4s per item, as surface_oracle.comp reads them: (triangle bits, barycentrics,
