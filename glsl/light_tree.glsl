@@ -2,7 +2,7 @@
 // (pbrt-v4 BVHLightSampler; Conty Estevez & Kulla 2018), built on the host (src/scene/light_tree.rs)
 // and stored in the emitter buffer right after the emitter rows: a header row (directional light
 // count, node count, 0, 0), then LIGHT_NODE_ROWS rows per node.
-// Directional lights are chosen beside the tree (light_select). Expects `emitters` and the
+// Directional lights are not in the tree: NEE takes each of them (light_select_pmf). Expects `emitters` and the
 // scene parameters (scene_bindings.glsl). Twin: src/shading/light_tree.rs.
 #ifndef LIGHT_TREE_GLSL
 #define LIGHT_TREE_GLSL
@@ -92,157 +92,79 @@ float light_node_importance(LightNode n, vec3 p, vec3 normal) {
 
 const uint WALK_SAMPLE = 0u;    // descend by u
 const uint WALK_TRAIL = 1u;     // descend along a light's bit trail
-const uint WALK_ESTIMATE = 2u;  // descend to the more important child, summing the others
 
-// Descends the tree from the root at p. WALK_SAMPLE and WALK_TRAIL go to a child with
-// probability proportional to its importance, by u in [0, 1) or along the bit trail `trail`
-// (bit d: the second child at depth d), and return in `value` the product of the branch
-// probabilities: sampling a light and following its trail give the same product for the same p.
-// WALK_ESTIMATE goes to the more important child and returns in `value` the importance of the
-// leaf reached plus that of every child passed by: a deterministic estimate of what the tree's
-// lights send to p, refined towards the one that sends most. Returns the emitter row of the leaf
-// reached (NO_EMITTER where no light below can reach p: then a probability of 0).
-// Twin: light_tree::light_tree_walk.
-uint light_tree_walk(vec3 p, vec3 normal, uint mode, uint trail, float u, out float value) {
-    value = mode == WALK_ESTIMATE ? 0.0 : 1.0;
+// Descends the tree from the root at p to a child with probability proportional to its
+// importance, by u in [0, 1) (WALK_SAMPLE) or along the bit trail `trail` (WALK_TRAIL; bit d: the
+// second child at depth d), and returns in `pmf` the product of the branch probabilities:
+// sampling a light and following its trail give the same product for the same p. Returns the
+// emitter row of the leaf reached (NO_EMITTER where no light below can reach p: then a
+// probability of 0). Twin: light_tree::light_tree_walk.
+uint light_tree_walk(vec3 p, vec3 normal, uint mode, uint trail, float u, out float pmf) {
+    pmf = 1.0;
     uint node = 0u;
-    float reached = -1.0;  // the importance of `node`, once known
     uint depth = 0u;
     for (; depth <= LIGHT_TREE_MAX_DEPTH; depth++) {
         loop_tick();
         LightNode n = light_node(node);
-        if ((n.flags & LIGHT_NODE_LEAF) != 0u) {
-            if (mode == WALK_ESTIMATE) value += reached >= 0.0 ? reached : light_node_importance(n, p, normal);
-            return n.child;
-        }
+        if ((n.flags & LIGHT_NODE_LEAF) != 0u) return n.child;
         float first = light_node_importance(light_node(node + 1u), p, normal);
         float second = light_node_importance(light_node(n.child), p, normal);
         if (!(first + second > 0.0)) {
-            // No light below reaches p: a dead end (the estimate keeps what it passed by).
-            if (mode != WALK_ESTIMATE) value = 0.0;
+            // No light below reaches p: a dead end.
+            pmf = 0.0;
             return NO_EMITTER;
         }
         float p_first = first / (first + second);
-        bool take_second = mode == WALK_SAMPLE ? u >= p_first : mode == WALK_TRAIL ? (trail & 1u) != 0u : second > first;
-        if (mode == WALK_ESTIMATE) value += take_second ? first : second;
+        bool take_second = mode == WALK_SAMPLE ? u >= p_first : (trail & 1u) != 0u;
         if (take_second) {
-            if (mode != WALK_ESTIMATE) value *= 1.0 - p_first;
+            pmf *= 1.0 - p_first;
             u = min((u - p_first) / (1.0 - p_first), 0.99999994);
             node = n.child;
         } else {
-            if (mode != WALK_ESTIMATE) value *= p_first;
+            pmf *= p_first;
             u = min(u / p_first, 0.99999994);
             node = node + 1u;
         }
-        reached = take_second ? second : first;
         trail >>= 1u;
     }
     // The tree is at most LIGHT_TREE_MAX_DEPTH deep: only the driver's loop budget ends here.
     note_loop_exit(depth <= LIGHT_TREE_MAX_DEPTH);
-    value = 0.0;
+    pmf = 0.0;
     return NO_EMITTER;
 }
 
 // Probability of choosing the environment rather than another light.
 float env_select_prob() { return scene_env.w; }
 
-// A unit direction from its octahedral encoding (two 16-bit fixed-point coordinates).
-// Twin: light_tree::octahedral_decode.
-vec3 octahedral_decode(uint bits) {
-    vec2 f = vec2(float(bits & 0xffffu), float(bits >> 16u)) * (2.0 / 65535.0) - 1.0;
-    vec3 v = vec3(f, 1.0 - abs(f.x) - abs(f.y));
-    float t = max(-v.z, 0.0);
-    v.x += v.x >= 0.0 ? -t : t;
-    v.y += v.y >= 0.0 ? -t : t;
-    return normalize(v);
-}
+// The emitter row of directional light k (k < directional_count()).
+uint directional_row(uint k) { return emitter_count - directional_count() + k; }
 
-// What directional light `row` sends to a surface of normal `normal`, for choosing: E |cos θ|,
-// the cosine floored at 1e-3 so that no light is ever left out (shading normals may tilt).
-// Twin: light_tree::directional_weight.
-float directional_weight(uint row, vec3 normal) {
-    Emitter e = emitters[row];
-    return e.intensity * max(abs(dot(normal, octahedral_decode(e.trail))), 1e-3);
-}
+// Directional lights are not chosen: NEE estimates every one of them at every vertex
+// (sample_directional in lights.glsl), with probability 1, beside the one light it draws here
+// from the tree. A one-sample choice between a sun and the tree's lamps gave a lamp fewer
+// samples wherever the sun outshone it, and wasted the sun's where the lamp's fixture shaded it
+// (docs/light-sampling.md).
 
-// The directional lights' summed weights at a surface of normal `normal`.
-float directional_total(vec3 normal) {
-    float total = 0.0;
-    for (uint i = emitter_count - directional_count(); i < emitter_count; i++) {
-        loop_tick();
-        total += directional_weight(i, normal);
-    }
-    return total;
-}
-
-// The probability of choosing the tree rather than a directional light at p (the environment's
-// share aside): the tree's WALK_ESTIMATE against the directional lights' weights, so that a lamp
-// where it outshines the sun is chosen as if the sun were not there, and the sun where it
-// outshines the lamps. Directional lights are then chosen in proportion to their weights.
-float tree_share(float estimate, float total) { return estimate > 0.0 ? estimate / (estimate + total) : 0.0; }
-
-// Both functions below return (or take) an emitter row and its probability at p with normal
-// `normal`, the environment's share removed (1 - env_select_prob()). One walk call in a loop of
-// two passes keeps one copy of the walk in each.
-
-// The probability that light sampling at p chooses the light of emitter row `row` (discrete).
+// The probability that light sampling at p (normal `normal`) chooses the light of emitter row
+// `row`: for a light of the tree, its walk's, the environment's share removed
+// (1 - env_select_prob()); 1 for a directional light, which NEE always takes.
 // Twin: light_tree::light_select_pmf.
 float light_select_pmf(vec3 p, vec3 normal, uint row) {
-    uint n_dir = directional_count();
-    bool has_tree = emitter_count > n_dir;
-    bool in_tree = row < emitter_count - n_dir;
-    float total = n_dir > 0u ? directional_total(normal) : 0.0;
-    float share = has_tree ? 1.0 : 0.0;
-    float walk = 1.0;
-    // Pass 0 (beside directional lights only) weighs the tree; pass 1 follows the light's trail.
-    for (uint pass = has_tree && n_dir > 0u ? 0u : 1u; pass < 2u; pass++) {
-        if (pass == 1u && !in_tree) break;
-        float value;
-        light_tree_walk(p, normal, pass == 0u ? WALK_ESTIMATE : WALK_TRAIL, emitters[row].trail, 0.0, value);
-        if (pass == 0u) share = tree_share(value, total);
-        else walk = value;
-    }
-    float pmf = in_tree ? share * walk : (1.0 - share) * (directional_weight(row, normal) / total);
-    return pmf * (1.0 - env_select_prob());
+    if (row >= emitter_count - directional_count()) return 1.0;
+    float walk;
+    light_tree_walk(p, normal, WALK_TRAIL, emitters[row].trail, 0.0, walk);
+    return walk * (1.0 - env_select_prob());
 }
 
-// The emitter row that light sampling at p draws with u in [0, 1) (NO_EMITTER when no light can
-// reach p) and, in pmf, its probability as light_select_pmf gives it. Twin: light_tree::light_select.
+// The emitter row of the tree that light sampling at p draws with u in [0, 1) (NO_EMITTER when
+// the tree is empty or no light of it can reach p) and, in pmf, its probability as
+// light_select_pmf gives it. Twin: light_tree::light_select.
 uint light_select(vec3 p, vec3 normal, float u, out float pmf) {
-    uint n_dir = directional_count();
-    bool has_tree = emitter_count > n_dir;
-    float total = n_dir > 0u ? directional_total(normal) : 0.0;
-    float share = has_tree ? 1.0 : 0.0;
-    uint row = NO_EMITTER;
     pmf = 0.0;
-    // Pass 0 (beside directional lights only) weighs the tree; pass 1 draws from it.
-    for (uint pass = has_tree && n_dir > 0u ? 0u : 1u; pass < 2u; pass++) {
-        if (pass == 1u && !(u < share)) break;
-        float value;
-        uint r = light_tree_walk(p, normal, pass == 0u ? WALK_ESTIMATE : WALK_SAMPLE, 0u, min(u / share, 0.99999994), value);
-        if (pass == 0u) {
-            share = tree_share(value, total);
-        } else {
-            row = r;
-            pmf = share * value;
-        }
-    }
-    if (!(u < share) && n_dir > 0u) {
-        // A directional light by weight: the first whose running sum passes the target.
-        float target = (u - share) / (1.0 - share) * total;
-        float sum = 0.0;
-        row = emitter_count - 1u;
-        for (uint i = emitter_count - n_dir; i < emitter_count; i++) {
-            loop_tick();
-            sum += directional_weight(i, normal);
-            if (target < sum) {
-                row = i;
-                break;
-            }
-        }
-        pmf = (1.0 - share) * (directional_weight(row, normal) / total);
-    }
-    pmf *= 1.0 - env_select_prob();
+    if (emitter_count == directional_count()) return NO_EMITTER;
+    float walk;
+    uint row = light_tree_walk(p, normal, WALK_SAMPLE, 0u, u, walk);
+    pmf = walk * (1.0 - env_select_prob());
     return row;
 }
 

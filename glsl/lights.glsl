@@ -1,8 +1,9 @@
-// Next-event estimation: emissive triangles and punctual lights chosen by their likely
+// Next-event estimation: emissive triangles and point and spot lights chosen by their likely
 // contribution at the shading point through the light tree (light_tree.glsl), uniform area
-// sampling, and the environment beside them with a fixed probability. A
-// punctual light's sample is a delta: pdf is the discrete probability of choosing it, radiance
-// is I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
+// sampling, and the environment beside them with a fixed probability; every directional light
+// besides, at every vertex (sample_directional). A punctual light's sample is a delta: pdf is
+// the discrete probability of choosing it (1 for a directional light), radiance is
+// I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
 // `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: src/shading/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
@@ -22,6 +23,10 @@
 #endif
 #ifndef SCENE_PUNCTUAL
 #define SCENE_PUNCTUAL 1
+#endif
+// Whether the scene has directional lights, which NEE takes at every vertex (sample_directional).
+#ifndef SCENE_DIRECTIONAL
+#define SCENE_DIRECTIONAL 1
 #endif
 // An equirectangular environment map (src/scene/environment.rs) replaces the constant environment; its
 // rows start SCENE_ENV_MAP_BASE rows after the emitter rows in the emitter buffer (after the light
@@ -242,7 +247,7 @@ LightSample sample_light(vec3 p, vec3 n, vec3 u) {
         ls.pdf = environment_pdf(ls.dir);
         return ls;
     }
-    if (SCENE_EMITTERS == 0 || emitter_count == 0u) return ls;
+    if (SCENE_EMITTERS == 0 || emitter_count == directional_count()) return ls;
     float u_select = (u.x - p_env) / (1.0 - p_env);
     float pmf;
     uint row = light_select(p, n, min(u_select, 0.99999994), pmf);
@@ -274,6 +279,18 @@ LightSample sample_light(vec3 p, vec3 n, vec3 u) {
     ls.dir = to_light / ls.dist;
     ls.radiance = emitted_radiance(e.triangle, b, -ls.dir);
     ls.pdf = emitter_area_pdf(pmf, e.triangle, ls.dir, ls.dist);
+    return ls;
+}
+
+// The sample of directional light k (k < directional_count()) that NEE adds at every vertex
+// beside sample_light's: towards the light, at infinity, its irradiance E, probability 1.
+// Twin: lights::sample_directional.
+LightSample sample_directional(uint k) {
+    uint id = emitters[directional_row(k)].triangle;
+    LightSample ls;
+    punctual_arrival(punctual_light(id & ~PUNCTUAL_LIGHT_BIT), vec3(0.0), ls.dir, ls.dist, ls.radiance);
+    ls.pdf = 1.0;
+    ls.triangle = id;
     return ls;
 }
 

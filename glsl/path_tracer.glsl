@@ -1,4 +1,5 @@
-// Unidirectional path tracing with NEE and BSDF sampling combined by the power heuristic, written
+// Unidirectional path tracing with NEE and BSDF sampling combined by the power heuristic (NEE:
+// one light drawn, plus every directional light, add_directional_lights), written
 // as a per-segment state machine: a kernel steps every lane once per iteration and restarts lanes
 // whose path ended, so SIMD lanes (lavapipe runs 8 in lockstep) stay busy however long paths are.
 // Each step traces one pair of rays in one traversal (trace_pair.glsl): the next segment and the
@@ -71,6 +72,26 @@ PathState path_begin(uvec2 pixel, uint seed) {
     return s;
 }
 
+// Adds to s.radiance what every directional light sends through the vertex x (geometric normal
+// ng, on triangle index tri; material m, shading normal ns, towards wo): NEE takes each of them
+// beside the light sample_light draws (light_tree.glsl), one shadow ray each, traced at once.
+void add_directional_lights(inout PathState s, vec3 x, vec3 ng, uint tri, Material m, vec3 ns, vec3 wo) {
+#if SCENE_PUNCTUAL && SCENE_DIRECTIONAL
+    uint n_dir = directional_count();
+    for (uint k = 0u; k < n_dir; k++) {
+        loop_tick();
+        LightSample ls = sample_directional(k);
+        float bsdf_pdf;
+        vec3 f = bsdf_eval_pdf(m, ng, ns, wo, ls.dir, bsdf_pdf);
+        if (!(max_component(f * ls.radiance) > 0.0)) continue;
+        Hit unused;
+        bool occluded;
+        trace_pair(PairRay(x, ls.dir, 0.0), shadow_ray(x, ng, tri, ls), unused, occluded);
+        if (!occluded) s.radiance += s.beta * f * ls.radiance;
+    }
+#endif
+}
+
 // Traces the pending shadow ray and the next segment, and scatters at the segment's end; returns
 // false once the path has ended.
 bool path_step(inout PathState s) {
@@ -116,6 +137,8 @@ bool path_step(inout PathState s) {
             s.nee = s.beta * f * ls.radiance * (w / ls.pdf);
         }
     }
+
+    add_directional_lights(s, x, ng, hit.triangle, m, ns, wo);
 
     // A path that ends here still traces its pending shadow ray in one more step.
     s.extend = false;

@@ -1,5 +1,6 @@
 // Initial candidates of ReSTIR PT: one traced path from the pixel's primary hit offers every
-// prefix that ends on a light, by NEE at a vertex or by a BSDF-sampled hit. A path either
+// prefix that ends on a light, by NEE at a vertex (the drawn light and every directional light,
+// each a technique of its own) or by a BSDF-sampled hit. A path either
 // technique can make is offered by both, each weighted by the balance heuristic
 // (end_mis_weight in shift_vertex.glsl): the two weighted integrands sum to the path's, and each is a
 // function of the path that the shifts evaluate anew (the end type travels in the record). The
@@ -19,6 +20,7 @@
 struct TracedCandidate {
     uint count;
     bool nee_end;
+    uint nee_directional;
     Vertex light;
     vec3 nee_weight;
     float end_weight;
@@ -46,6 +48,7 @@ bool offer_candidate(inout Resampler s, vec3 contribution, float scale, float u)
 void record_chosen(inout Resampler s, Path p, TracedCandidate c, ShiftParams params) {
     p.count = c.count;
     p.nee_end = c.nee_end;
+    p.nee_directional = c.nee_directional;
     if (c.nee_end) {
         set_path_vertex(c.count - 1u, c.light);
         set_path_lobe(c.count - 2u, LOBE_NONE);
@@ -67,7 +70,7 @@ void record_chosen(inout Resampler s, Path p, TracedCandidate c, ShiftParams par
 void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed, uint max_length, ShiftParams params,
                             float scale) {
     Path p;
-    path_begin(camera, y1, seed, false, p);
+    path_begin(camera, y1, seed, false, 0u, p);
     vec3 prefix = vec3(1.0);
     vec3 prev_pos = camera;
     TracedCandidate chosen;
@@ -81,21 +84,26 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         Material m = vertex_shading(x, ns);
         vec4 u = rng_uniform4(seed, i, STREAM_RESAMPLE);
 
-        LightSample ls;
-        Vertex light;
-        if (nee_vertex(x, seed, i, ls, light)) {
+        // NEE's techniques at x: the drawn light (t = 0), then every directional light (t = k + 1),
+        // each a candidate of its own, in one loop so that the kernel holds one visibility test.
+        uint techniques = 1u + (SCENE_PUNCTUAL != 0 && SCENE_DIRECTIONAL != 0 ? directional_count() : 0u);
+        for (uint t = 0u; t < techniques; ++t) {
+            loop_tick();
+            LightSample ls;
+            Vertex light;
+            if (!nee_vertex(x, seed, i, t, ls, light)) continue;
             float bsdf_pdf;
             vec3 f_cos = bsdf_eval_pdf(m, x.normal, ns, wo, ls.dir, bsdf_pdf);
-            if (max_component(f_cos) > 0.0 && visible(x, light)) {
-                vec3 weight = f_cos / ls.pdf;
-                // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand (equal
-                // to rounding): evaluating the BSDF again took 5% of the pass.
-                float end_weight = vertex_is_punctual(light) ? 1.0 : balance_heuristic(ls.pdf, bsdf_pdf);
-                vec3 contribution = prefix * weight * end_emission(x, light) * end_weight;
-                if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u.x)) {
-                    chosen = TracedCandidate(i + 1u, true, light, weight, end_weight, contribution);
-                    chose = true;
-                }
+            if (!(max_component(f_cos) > 0.0) || !visible(x, light)) continue;
+            vec3 weight = f_cos / ls.pdf;
+            // end_mis_weight(x, prev_pos, light, true, false) from the pdfs at hand (equal
+            // to rounding): evaluating the BSDF again took 5% of the pass.
+            float end_weight = vertex_is_punctual(light) ? 1.0 : balance_heuristic(ls.pdf, bsdf_pdf);
+            vec3 contribution = prefix * weight * end_emission(x, light) * end_weight;
+            float u_offer = t == 0u ? u.x : rng_uniform4(seed, i, STREAM_DIRECTIONAL + t - 1u).x;
+            if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u_offer)) {
+                chosen = TracedCandidate(i + 1u, true, t, light, weight, end_weight, contribution);
+                chose = true;
             }
         }
 
@@ -112,7 +120,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
             float end_weight = end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
             vec3 contribution = prefix * emitted * end_weight;
             if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u.y)) {
-                chosen = TracedCandidate(i + 1u, false, next, vec3(0.0), end_weight, contribution);
+                chosen = TracedCandidate(i + 1u, false, 0u, next, vec3(0.0), end_weight, contribution);
                 chose = true;
             }
         }

@@ -33,5 +33,6 @@ const uint STREAM_CAMERA = 0u;
 const uint STREAM_BSDF = 1u;
 const uint STREAM_LIGHT = 2u;
 const uint STREAM_RESAMPLE = 3u;  // ReSTIR's choices among candidates, keyed by a pass seed
+const uint STREAM_DIRECTIONAL = 4u;  // ReSTIR's choice of directional light k's NEE candidate: + k
 
 #endif

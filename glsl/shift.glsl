@@ -19,7 +19,7 @@ ShiftResult finish_random_replay(ShiftParams params, PathRecord base, Path y) {
 
 ShiftResult shift_random_replay(ShiftParams params, PathRecord base, vec3 camera, Vertex y1) {
     Path y;
-    if (!trace_vertices(camera, y1, base.seed, record_length(base), record_nee_end(base), y)) return shift_failed();
+    if (!trace_vertices(camera, y1, base.seed, record_length(base), record_nee_end(base), record_nee_directional(base), y)) return shift_failed();
     return finish_random_replay(params, base, y);
 }
 
@@ -36,7 +36,7 @@ ShiftResult shift_hybrid(ShiftParams params, PathRecord base, vec3 camera, Verte
     bool replay = r == 0u;
     Path y;
     uint length = replay ? record_length(base) : r - 1u;
-    if (!trace_vertices(camera, y1, base.seed, length, replay && record_nee_end(base), y)) return shift_failed();
+    if (!trace_vertices(camera, y1, base.seed, length, replay && record_nee_end(base), replay ? record_nee_directional(base) : 0u, y)) return shift_failed();
     if (!replay) return finish_reconnection(params, base, y, r);
     if (!finish_path(y)) return shift_failed();
     PathRecord record;

@@ -17,6 +17,7 @@ struct Path {
     vec3 camera;
     uint count;                        // the number of vertices k
     bool nee_end;
+    uint nee_directional;              // NEE's technique at the end: 0 the drawn light, k + 1 directional light k
     vec3 contribution;
     float end_weight;                  // end_mis_weight of the technique that made x_k
 };
@@ -55,10 +56,11 @@ uint reconnection_index(Path path, ShiftParams params) {
     return 0u;
 }
 
-// The light point NEE at x_i chooses with the path's random numbers; false if none can be chosen.
-// Visibility is left to the caller.
-bool nee_vertex(Vertex x, uint seed, uint i, out LightSample ls, out Vertex light) {
-    ls = sample_light(x.pos, x.normal, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
+// The light point NEE at x_i takes with technique `directional`: directional light
+// `directional` - 1, or for 0 the light it draws with the path's random numbers; false if none
+// can be chosen. Visibility is left to the caller.
+bool nee_vertex(Vertex x, uint seed, uint i, uint directional, out LightSample ls, out Vertex light) {
+    ls = directional > 0u ? sample_directional(directional - 1u) : sample_light(x.pos, x.normal, rng_uniform4(seed, i, STREAM_LIGHT).xyz);
     if (!(ls.pdf > 0.0)) return false;
     if (SCENE_PUNCTUAL != 0 && is_punctual_light(ls.triangle)) {
         light = vertex_punctual(ls.triangle);
@@ -93,21 +95,23 @@ bool bsdf_vertex(Vertex x, vec3 wo, Material m, vec3 ns, uint seed, uint i, out 
 }
 
 // A path of the single vertex x1 from `camera`, to be extended with `seed`'s random numbers.
-void path_begin(vec3 camera, Vertex x1, uint seed, bool nee_end, out Path path) {
+void path_begin(vec3 camera, Vertex x1, uint seed, bool nee_end, uint nee_directional, out Path path) {
     path.seed = seed;
     path.camera = camera;
     path.count = 1u;
     path.nee_end = nee_end;
+    path.nee_directional = nee_directional;
     set_path_vertex(0, x1);
     path.contribution = vec3(0.0);
     path.end_weight = 0.0;
 }
 
-// The vertices, lobes and weights of a path regenerated from x1 with `seed`. Each step traces
-// one ray, a shadow ray for the NEE step and a closest-hit ray otherwise, through a single
-// traversal (see visibility_ray).
-bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, out Path path) {
-    path_begin(camera, x1, seed, nee_end, path);
+// The vertices, lobes and weights of a path regenerated from x1 with `seed`, its end made by NEE
+// with technique `nee_directional` (nee_vertex) when `nee_end`. Each step traces one ray, a
+// shadow ray for the NEE step and a closest-hit ray otherwise, through a single traversal (see
+// visibility_ray).
+bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool nee_end, uint nee_directional, out Path path) {
+    path_begin(camera, x1, seed, nee_end, nee_directional, path);
     // A path's rows in shared memory hold MAX_PATH_LENGTH vertices; writing past them would
     // overwrite another invocation's path.
     if (target_length > MAX_PATH_LENGTH) return false;
@@ -128,7 +132,7 @@ bool trace_vertices(vec3 camera, Vertex x1, uint seed, uint target_length, bool 
         float tmax;
         if (nee_step) {
             LightSample ls;
-            if (!nee_vertex(x, seed, i, ls, next)) return false;
+            if (!nee_vertex(x, seed, i, nee_directional, ls, next)) return false;
             float bsdf_pdf;
             lobe = LOBE_NONE;
             weight = bsdf_eval_pdf(m, x.normal, ns, wo, ls.dir, bsdf_pdf) / ls.pdf;

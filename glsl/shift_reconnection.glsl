@@ -101,7 +101,7 @@ uint record_fields(Path path, ShiftParams params, out PathRecord record) {
     uint k = path.count;
     uint r = reconnection_index(path, params);
     record.seed = path.seed;
-    record.info = pack_info(k, r, path.nee_end);
+    record.info = pack_info(k, r, path.nee_end, path.nee_directional);
     record.lobes = 0u;
     for (uint i = 0u; i + 1u < k; ++i) {
         loop_tick();
@@ -186,7 +186,7 @@ ShiftResult finish_reconnection(ShiftParams params, PathRecord base, Path prefix
 
 ShiftResult reconnect_at(ShiftParams params, PathRecord base, vec3 camera, Vertex y1, uint r) {
     Path prefix;
-    if (!trace_vertices(camera, y1, base.seed, r - 1u, false, prefix)) return shift_failed();
+    if (!trace_vertices(camera, y1, base.seed, r - 1u, false, 0u, prefix)) return shift_failed();
     return finish_reconnection(params, base, prefix, r);
 }
 

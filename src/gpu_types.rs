@@ -121,15 +121,14 @@ pub struct Emitter {
     /// The emissive triangle's index, or [`PUNCTUAL_LIGHT_BIT`] | the punctual light's index.
     pub triangle: u32,
     /// The light tree's bit trail (pbrt-v4 `BVHLightSampler`): bit d set when the path from the
-    /// root to this light's leaf takes the second child at depth d. For a directional light,
-    /// its direction (`shading::light_tree::octahedral_encode`).
+    /// root to this light's leaf takes the second child at depth d; 0 for a directional light.
     pub trail: u32,
     /// The light's largest radiant intensity, luminance (W/sr in the glTF emission unit): L·A
     /// for an emissive triangle, I for a point or spot light, the irradiance E for a
     /// directional light.
     pub intensity: f32,
     /// Index of the light's leaf among the light tree's nodes; `NO_EMITTER` for directional
-    /// lights, which are chosen beside the tree.
+    /// lights, which NEE takes beside the tree's drawn light.
     pub leaf: u32,
 }
 

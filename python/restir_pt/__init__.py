@@ -27,6 +27,7 @@ from ._native import (
     devices,
     energy_ratio,
     flip,
+    hdr_flip,
     mape,
     merge_shards,
     mse,
@@ -42,7 +43,7 @@ from ._native import compare as _compare
 __all__ = [
     "Camera", "Device", "DeviceError", "PathTracer", "Restir", "RestirPtError", "Scene",
     "SceneError", "SceneWarning", "SettingsError", "UploadedScene", "RESTIR_OPTIONS",
-    "camera_on_path", "compare", "devices", "energy_ratio", "flip", "mape", "merge_shards",
+    "camera_on_path", "compare", "devices", "energy_ratio", "flip", "hdr_flip", "mape", "merge_shards",
     "mse", "read_exr", "reference", "rel_mse", "rel_mse_trimmed", "render", "write_exr",
 ]
 

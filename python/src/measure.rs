@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use crate::renderers::render_interruptible;
 use crate::scene::PyUploadedScene;
 use crate::{error_of, from_array, py_error, to_array, without_gil, Kind};
-use restir_pt::image_io::{auto_exposure_ev, read_exr as read_exr_file, srgb_encode, write_exr as write_exr_file};
+use restir_pt::image_io::{auto_exposure_ev, read_exr as read_exr_file, write_exr as write_exr_file};
 use restir_pt::metrics;
 use restir_pt::reference_shard::{merge_shards as merge_shard_files, write_shard, ShardMeta, ShardSpec, ShardSums};
 use restir_pt::render::{Image, PathTracer, RenderSettings};
@@ -21,6 +21,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mse, m)?)?;
     m.add_function(wrap_pyfunction!(energy_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(flip, m)?)?;
+    m.add_function(wrap_pyfunction!(hdr_flip, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(reference, m)?)?;
@@ -82,7 +83,7 @@ fn energy_ratio(image: &Bound<'_, PyAny>, reference: &Bound<'_, PyAny>) -> PyRes
 /// the two images after one tonemapping: radiance times 2^exposure (None: the reference's
 /// automatic exposure, as the CLI's PNG previews), clamped to [0, 1], sRGB-encoded to 8 bits.
 /// Returns the mean ꟻLIP error in [0, 1], or (mean, error map (height, width) float32) with
-/// `error_map`. HDR-ꟻLIP is not offered.
+/// `error_map`. `hdr_flip` is the HDR metric.
 #[pyfunction]
 #[pyo3(signature = (image, reference, *, exposure = None, pixels_per_degree = nv_flip::DEFAULT_PIXELS_PER_DEGREE, error_map = false))]
 fn flip<'py>(
@@ -105,24 +106,30 @@ fn flip<'py>(
         Some(ev) => return Err(error_of(Kind::Settings, format!("exposure {ev} must be a finite EV"))),
         None => auto_exposure_ev(&r),
     };
-    let scale = ev.exp2();
-    let ldr = |pixels: &[glam::Vec3]| -> Vec<u8> {
-        pixels
-            .iter()
-            .map(|&p| p * scale)
-            .flat_map(|p| [srgb_encode(p.x), srgb_encode(p.y), srgb_encode(p.z)])
-            .collect()
-    };
-    let (test, refr) = (ldr(&x), ldr(&r));
-    let errors = without_gil(py, || {
-        let map = nv_flip::flip(
-            nv_flip::FlipImageRgb8::with_data(w, h, &refr),
-            nv_flip::FlipImageRgb8::with_data(w, h, &test),
-            pixels_per_degree,
-        );
-        map.to_vec()
-    });
-    let mean = errors.iter().map(|&e| e as f64).sum::<f64>() / errors.len() as f64;
+    let errors = without_gil(py, || metrics::ldr_flip_map(&x, &r, w, h, ev, pixels_per_degree));
+    mean_and_map(py, errors, (w, h), error_map)
+}
+
+/// HDR-ꟻLIP (Andersson et al. 2021; `restir_pt::metrics::hdr_flip`) of two linear-radiance
+/// images: the per-pixel maximum of LDR-ꟻLIP over exposures from the reference's brightest to
+/// its median luminance, ACES-tone-mapped. Returns the mean in [0, 1], or (mean, error map
+/// (height, width) float32) with `error_map`.
+#[pyfunction]
+#[pyo3(signature = (image, reference, *, error_map = false))]
+fn hdr_flip<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    reference: &Bound<'py, PyAny>,
+    error_map: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (w, h, x, r) = pair(image, reference)?;
+    let errors = without_gil(py, || metrics::hdr_flip_map(&x, &r, w, h));
+    mean_and_map(py, errors, (w, h), error_map)
+}
+
+/// The mean of an error map, with the map as (height, width) float32 when asked.
+fn mean_and_map(py: Python<'_>, errors: Vec<f32>, (w, h): (u32, u32), error_map: bool) -> PyResult<Bound<'_, PyAny>> {
+    let mean = errors.iter().map(|&e| e as f64).sum::<f64>() / errors.len().max(1) as f64;
     if error_map {
         let map = numpy::PyArray1::from_vec(py, errors);
         let map = numpy::PyArrayMethods::reshape(&map, [h as usize, w as usize])?;
@@ -307,6 +314,9 @@ fn compare<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Vec<Bound<'py, P
             dict.set_item("energy_ratio", row.energy_ratio)?;
             dict.set_item("failed_shift_rate", row.failed_shift_rate)?;
             dict.set_item("nonfinite_pixels", row.nonfinite_pixels)?;
+            dict.set_item("mape", row.mape)?;
+            dict.set_item("hdr_flip", row.hdr_flip)?;
+            dict.set_item("pt_samples_per_frame", row.pt_samples_per_frame)?;
             Ok(dict)
         })
         .collect()

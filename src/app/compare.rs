@@ -18,7 +18,7 @@ use super::render_output::status_spinner;
 use super::sweep::SweepMode;
 use super::{finish_device, load_with_warnings, open_device, scene_path};
 use restir_pt::image_io::read_exr;
-use restir_pt::metrics::{energy_ratio, median, mse, rel_mse, rel_mse_trimmed, standard_error, TRIMMED_SHARE};
+use restir_pt::metrics::{energy_ratio, hdr_flip, mape, median, mse, rel_mse, rel_mse_trimmed, standard_error, TRIMMED_SHARE};
 use restir_pt::render::{Image, RenderSettings, SceneGpu, SceneInfo, MAX_RESERVOIRS};
 use restir_pt::scene::{camera_on_path, Scene};
 
@@ -80,6 +80,15 @@ pub struct CompareRow {
     pub energy_ratio: f64,
     pub failed_shift_rate: Option<f64>,
     pub nonfinite_pixels: usize,
+    /// Mean absolute percentage error (metrics::mape), the mean over trials.
+    pub mape: f64,
+    /// HDR-ꟻLIP (metrics::hdr_flip), the mean over trials.
+    pub hdr_flip: f64,
+    /// The frame's GPU time in path-tracer samples per pixel of the same scene, size and
+    /// camera, measured in the same process: `gpu_ms_per_frame` over the path tracer's ms per
+    /// sample (the slope of its calibration, `Cost::Affine::per_sample`). None where the run
+    /// has no `pt` method (each `--job` of a sweep runs one method).
+    pub pt_samples_per_frame: Option<f64>,
 }
 
 /// A method's frame cost, measured after its kernels are compiled.
@@ -126,6 +135,8 @@ pub(super) struct Run<'a> {
     pub reference_spp: Option<u32>,
     /// GPU ms of every frame rendered so far (calibration included), for the job's accounting.
     pub gpu_ms: Cell<f64>,
+    /// The path tracer's GPU ms per sample per pixel, once a `pt` method is calibrated.
+    pub pt_ms_per_sample: Cell<Option<f64>>,
 }
 
 /// What `Run::sequence` measured.
@@ -135,7 +146,18 @@ struct Sequence {
     last_frame: Image,
 }
 
-impl Run<'_> {
+impl<'a> Run<'a> {
+    pub(super) fn new(camera_count: usize, settings: &'a RenderSettings, camera_path: bool, reference_spp: Option<u32>) -> Self {
+        Run {
+            camera_count,
+            settings,
+            camera_path,
+            reference_spp,
+            gpu_ms: Cell::new(0.0),
+            pt_ms_per_sample: Cell::new(None),
+        }
+    }
+
     /// The camera of frame `frame`.
     pub(super) fn camera(&self, frame: u32) -> usize {
         if self.camera_path {
@@ -183,6 +205,7 @@ impl Run<'_> {
                 renderer.set_cost_knob(SAMPLES)?;
                 let more = self.sequence(renderer, CALIBRATION_FRAMES, 0)?.gpu_ms_per_frame;
                 let per_sample = ((more - one) / (SAMPLES - 1) as f64).max(0.1 * more / SAMPLES as f64);
+                self.pt_ms_per_sample.set(Some(per_sample));
                 Ok(Cost::Affine {
                     fixed: (one - per_sample).max(0.0),
                     per_sample,
@@ -265,13 +288,7 @@ pub(super) struct Setup {
 
 impl Setup {
     pub(super) fn run(&self, camera_path: bool) -> Run<'_> {
-        Run {
-            camera_count: self.scene.cameras.len(),
-            settings: &self.settings,
-            camera_path,
-            reference_spp: self.reference_spp,
-            gpu_ms: Cell::new(0.0),
-        }
+        Run::new(self.scene.cameras.len(), &self.settings, camera_path, self.reference_spp)
     }
 }
 
@@ -447,14 +464,19 @@ pub(super) fn measure(
     let knob = run.fit_to_budget(renderer, knob, budget, args.frames)?;
     warn_noisy_reference(renderer, knob, run.reference_spp, label, budget);
     let (mut times, mut rels, mut trimmed, mut abs, mut energy, mut failed, mut nonfinite) = (vec![], vec![], 0.0, 0.0, 0.0, None, 0);
+    let (mut percentage, mut flip) = (0.0, 0.0);
     let mut last = None;
+    let share = 1.0 / args.trials as f64;
     for t in 0..args.trials {
         let seq = run.sequence(renderer, args.frames, args.path.seed.wrapping_add(1 + t))?;
+        let image = &seq.last_frame;
         times.push(seq.gpu_ms_per_frame);
-        rels.push(rel_mse(&seq.last_frame.mean, reference));
-        trimmed += rel_mse_trimmed(&seq.last_frame.mean, reference, TRIMMED_SHARE) / args.trials as f64;
-        abs += mse(&seq.last_frame.mean, reference) / args.trials as f64;
-        energy += energy_ratio(&seq.last_frame.mean, reference) / args.trials as f64;
+        rels.push(rel_mse(&image.mean, reference));
+        trimmed += rel_mse_trimmed(&image.mean, reference, TRIMMED_SHARE) * share;
+        abs += mse(&image.mean, reference) * share;
+        energy += energy_ratio(&image.mean, reference) * share;
+        percentage += mape(&image.mean, reference) * share;
+        flip += hdr_flip(&image.mean, reference, image.width, image.height) * share;
         failed = seq.failed_shift_rate.map(|f| failed.unwrap_or(0.0) + f / args.trials as f64);
         nonfinite += seq.last_frame.non_finite_count();
         last = Some(seq.last_frame);
@@ -471,16 +493,22 @@ pub(super) fn measure(
         energy_ratio: energy,
         failed_shift_rate: failed,
         nonfinite_pixels: nonfinite,
+        mape: percentage,
+        hdr_flip: flip,
+        pt_samples_per_frame: run.pt_ms_per_sample.get().map(|per_sample| median(&times) / per_sample),
     };
     println!(
-        "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame | relMSE {:.4e}{} (trimmed {:.4e}) | MSE {:.4e} | energy {:.4}{}",
+        "{:<28} budget {:>8.1} ms | {:<14} | {:>8.2} ms/frame{} | relMSE {:.4e}{} (trimmed {:.4e}) | MAPE {:.4} | HDR-FLIP {:.4} | MSE {:.4e} | energy {:.4}{}",
         row.method,
         budget,
         row.knob,
         row.gpu_ms_per_frame,
+        row.pt_samples_per_frame.map(|s| format!(" ({s:.2} PT spp)")).unwrap_or_default(),
         row.rel_mse,
         row.rel_mse_stderr.map(|e| format!(" ± {e:.1e}")).unwrap_or_default(),
         row.rel_mse_trimmed,
+        row.mape,
+        row.hdr_flip,
         row.mse,
         row.energy_ratio,
         row.failed_shift_rate

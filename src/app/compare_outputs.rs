@@ -38,16 +38,17 @@ fn worst_window(image: &[Vec3], reference: &[Vec3], width: u32, height: u32) -> 
     best.1
 }
 
-/// results.csv's columns; `rel_mse_stderr` is empty for one trial.
+/// results.csv's columns; `rel_mse_stderr` is empty for one trial, `pt_samples_per_frame`
+/// where the run has no path tracer to measure it by.
 pub(super) const CSV_HEADER: &str =
-    "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels,rel_mse_stderr";
+    "method,budget_ms,knob,gpu_ms_per_frame,rel_mse,rel_mse_trimmed,mse,energy_ratio,failed_shift_rate,nonfinite_pixels,rel_mse_stderr,mape,hdr_flip,pt_samples_per_frame";
 
 pub(super) fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
     let mut csv = format!("{CSV_HEADER}\n");
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.6e},{:.5},{},{},{}",
+            "{},{:.3},{},{:.4},{:.6e},{:.6e},{:.6e},{:.5},{},{},{},{:.6e},{:.6e},{}",
             r.method,
             r.budget_ms,
             r.knob,
@@ -58,7 +59,10 @@ pub(super) fn write_csv(path: &Path, rows: &[CompareRow]) -> Result<()> {
             r.energy_ratio,
             r.failed_shift_rate.map(|f| format!("{f:.5}")).unwrap_or_default(),
             r.nonfinite_pixels,
-            r.rel_mse_stderr.map(|e| format!("{e:.6e}")).unwrap_or_default()
+            r.rel_mse_stderr.map(|e| format!("{e:.6e}")).unwrap_or_default(),
+            r.mape,
+            r.hdr_flip,
+            r.pt_samples_per_frame.map(|s| format!("{s:.4}")).unwrap_or_default()
         );
     }
     std::fs::write(path, csv).with_context(|| format!("{}: cannot write", path.display()))
@@ -228,6 +232,9 @@ mod tests {
             energy_ratio: 1.0,
             failed_shift_rate: None,
             nonfinite_pixels: 0,
+            mape: rel_mse,
+            hdr_flip: rel_mse,
+            pt_samples_per_frame: None,
         }
     }
 

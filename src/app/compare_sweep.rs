@@ -103,6 +103,9 @@ fn parse_row(fields: &[String], path: &Path) -> Result<CompareRow> {
         energy_ratio: num(7)?,
         failed_shift_rate: parse_optional(&fields[8]).with_context(bad)?,
         nonfinite_pixels: fields[9].parse().with_context(bad)?,
+        mape: num(11)?,
+        hdr_flip: num(12)?,
+        pt_samples_per_frame: parse_optional(&fields[13]).with_context(bad)?,
     })
 }
 

@@ -1,5 +1,6 @@
 //! `restir-pt profile`: per-pass GPU times of ReSTIR PT frames as CSV, as a Chrome trace
-//! (opens in Perfetto or chrome://tracing) and as a stacked-bar SVG, with the median and p95.
+//! (opens in Perfetto or chrome://tracing) and as a stacked-bar SVG, with the median and p95,
+//! each also in path-tracer samples per pixel of the same scene and size, measured in the same run.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -9,6 +10,8 @@ use anyhow::{bail, Context as _, Result};
 use clap::Args;
 
 use super::args::{DeviceArgs, PathArgs, RestirArgs, SceneArgs, SizeArgs};
+use super::compare::{Cost, Run};
+use super::method_spec::{MethodRenderer, MethodSpec};
 use super::render_output::{compile_progress, print_compile_summary};
 use super::{finish_device, load_with_options, open_device};
 use restir_pt::metrics::quantile;
@@ -128,7 +131,10 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
     restir.validate(settings.max_depth)?;
     std::fs::create_dir_all(&args.out_dir).with_context(|| format!("{}: cannot create the output folder", args.out_dir.display()))?;
     let ctx = open_device(&args.device)?;
-    let times = pass_times(&SceneGpu::upload(&ctx, &scene)?, &settings, &restir, &args)?;
+    let gpu_scene = SceneGpu::upload(&ctx, &scene)?;
+    let times = pass_times(&gpu_scene, &settings, &restir, &args)?;
+    let pt_ms = path_tracer_ms_per_sample(&gpu_scene, &settings, args.camera_path)?;
+    drop(gpu_scene);
     finish_device(&ctx)?;
     let motion = if args.camera_path { "moving camera" } else { "static camera" };
     let title = format!(
@@ -139,7 +145,22 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
         settings.height,
         ctx.info.name
     );
-    write_outputs(&args, &times, &title)
+    write_outputs(&args, &times, pt_ms, &title)
+}
+
+/// The path tracer's GPU ms per sample per pixel of the same scene, size and camera (path),
+/// measured as `compare` calibrates it: the slope between 1- and 8-spp frames.
+fn path_tracer_ms_per_sample(scene: &Arc<SceneGpu>, settings: &RenderSettings, camera_path: bool) -> Result<f64> {
+    let settings = RenderSettings {
+        spp: 1,
+        ..settings.clone()
+    };
+    let run = Run::new(scene.info().cameras.len(), &settings, camera_path, None);
+    let mut renderer = MethodRenderer::new(scene, &settings, &MethodSpec::PathTracing)?;
+    match run.calibrate(&mut renderer)? {
+        Cost::Affine { per_sample, .. } => Ok(per_sample),
+        Cost::PerReservoirs(_) => bail!("the path tracer calibrated as ReSTIR PT"),
+    }
 }
 
 /// Every frame's GPU ms per pass.
@@ -167,25 +188,29 @@ fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirS
     Ok(times)
 }
 
-/// passes.csv, trace.json, passes.svg and the median/p95 table.
-fn write_outputs(args: &ProfileArgs, times: &[[f64; 4]], title: &str) -> Result<()> {
-    let mut csv = String::from("frame,pass,gpu_ms\n");
+/// passes.csv, trace.json, passes.svg and the median/p95 table, each time also in path-tracer
+/// samples per pixel (`pt_ms` GPU ms each).
+fn write_outputs(args: &ProfileArgs, times: &[[f64; 4]], pt_ms: f64, title: &str) -> Result<()> {
+    let mut csv = String::from("frame,pass,gpu_ms,pt_samples\n");
     for (f, t) in times.iter().enumerate() {
         for (p, ms) in t.iter().enumerate() {
-            let _ = writeln!(csv, "{f},{},{ms:.4}", PASS_NAMES[p]);
+            let _ = writeln!(csv, "{f},{},{ms:.4},{:.4}", PASS_NAMES[p], ms / pt_ms);
         }
     }
     write(&args.out_dir.join("passes.csv"), &csv)?;
     write(&args.out_dir.join("trace.json"), &serde_json::to_string(&chrome_trace(times))?)?;
     write(&args.out_dir.join("passes.svg"), &stacked_bar_svg(times, title))?;
     println!("{title}, {} frames: GPU ms per pass", args.frames);
-    println!("{:<10} {:>10} {:>10}", "pass", "median", "p95");
+    println!("path tracer: {pt_ms:.2} GPU ms per sample per pixel (same scene, size and camera; PT spp = ms / that)");
+    println!("{:<10} {:>10} {:>10} {:>10}", "pass", "median", "p95", "PT spp");
+    let row = |name: &str, v: &[f64]| {
+        let median = quantile(v, 0.5);
+        println!("{name:<10} {median:>10.2} {:>10.2} {:>10.2}", quantile(v, 0.95), median / pt_ms);
+    };
     for (p, name) in PASS_NAMES.iter().enumerate() {
-        let v: Vec<f64> = times.iter().map(|t| t[p]).collect();
-        println!("{name:<10} {:>10.2} {:>10.2}", quantile(&v, 0.5), quantile(&v, 0.95));
+        row(name, &times.iter().map(|t| t[p]).collect::<Vec<f64>>());
     }
-    let total: Vec<f64> = times.iter().map(|t| t.iter().sum()).collect();
-    println!("{:<10} {:>10.2} {:>10.2}", "frame", quantile(&total, 0.5), quantile(&total, 0.95));
+    row("frame", &times.iter().map(|t| t.iter().sum()).collect::<Vec<f64>>());
     eprintln!("wrote passes.csv, trace.json and passes.svg in {}", args.out_dir.display());
     Ok(())
 }

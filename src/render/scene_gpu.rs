@@ -261,6 +261,7 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ("SCENE_ENVIRONMENT", flag(scene.env_select_prob > 0.0)),
         ("SCENE_EMITTERS", flag(!scene.emitters.is_empty())),
         ("SCENE_PUNCTUAL", flag(!scene.lights.is_empty())),
+        ("SCENE_DIRECTIONAL", flag(scene.directional_count > 0)),
         ("SCENE_ENV_MAP", flag(scene.environment_map.is_some())),
         ("SCENE_ENV_MAP_BASE", format!("{}u", light_rows)),
         ("SCENE_UNIFORM_BUFFERS", flag(uniform)),

@@ -67,8 +67,8 @@ pub struct Scene {
     /// The light tree over the emitters before the directional ones (src/scene/light_tree.rs);
     /// empty when there are none.
     pub light_nodes: Vec<LightNode>,
-    /// Directional lights: the last rows of `emitters`, chosen beside the light tree
-    /// (`shading::light_tree::light_select`).
+    /// Directional lights: the last rows of `emitters`, outside the light tree: NEE takes each
+    /// of them at every vertex (`shading::lights::sample_directional`).
     pub directional_count: u32,
     /// Per punctual light (index into `lights`): its row in `emitters`.
     pub punctual_emitter_rows: Vec<u32>,
@@ -185,12 +185,23 @@ fn light_table(mut ids: Vec<u32>, mut bounds: Vec<LightBounds>, lights: &[Punctu
         rows[k] = emitters.len() as u32;
         emitters.push(Emitter {
             triangle: PUNCTUAL_LIGHT_BIT | k as u32,
-            trail: crate::shading::light_tree::octahedral_encode(light.direction),
+            trail: 0,
             intensity: luminance(light.intensity),
             leaf: NO_EMITTER,
         });
     }
     (emitters, tree, rows)
+}
+
+/// The probability that NEE samples the environment rather than a light of the light tree:
+/// directional lights are not drawn (NEE takes each of them beside the drawn light), so beside
+/// them alone the environment takes every draw.
+fn env_select_prob(has_env: bool, tree_empty: bool) -> f32 {
+    match (has_env, tree_empty) {
+        (false, _) => 0.0,
+        (true, true) => 1.0,
+        (true, false) => ENV_SELECT_PROB_WITH_EMITTERS,
+    }
 }
 
 impl Scene {
@@ -210,11 +221,7 @@ impl Scene {
         let (emitter_tris, bounds, triangle_power) = tag_triangles(&mut triangles, &parts.materials, &parts.textures);
         let (emitters, tree, punctual_emitter_rows) = light_table(emitter_tris, bounds, &parts.lights);
         let has_env = luminance(parts.environment) > 0.0 || parts.environment_map.is_some();
-        let env_select_prob = match (has_env, emitters.is_empty()) {
-            (false, _) => 0.0,
-            (true, true) => 1.0,
-            (true, false) => ENV_SELECT_PROB_WITH_EMITTERS,
-        };
+        let env_select_prob = env_select_prob(has_env, tree.trails.is_empty());
         let root = bvh.nodes[0];
         let triangles_empty = triangles.is_empty();
         Scene {
@@ -270,11 +277,8 @@ impl Scene {
     pub fn set_environment(&mut self, env: Vec3) {
         self.environment = env;
         self.environment_map = None;
-        self.env_select_prob = match (luminance(env) > 0.0, self.emitters.is_empty()) {
-            (false, _) => 0.0,
-            (true, true) => 1.0,
-            (true, false) => ENV_SELECT_PROB_WITH_EMITTERS,
-        };
+        let tree_empty = self.emitters.len() == self.directional_count as usize;
+        self.env_select_prob = env_select_prob(luminance(env) > 0.0, tree_empty);
     }
 
     /// The largest side of the scene's bounds (scene units).

@@ -1,5 +1,6 @@
 //! Initial candidates of ReSTIR PT: one traced path from a primary hit offers every prefix that
-//! ends on a light, by NEE at a vertex or by a BSDF-sampled hit, each weighted by the balance
+//! ends on a light, by NEE at a vertex (the drawn light and every directional light, each a
+//! technique of its own) or by a BSDF-sampled hit, each weighted by the balance
 //! heuristic of its end technique (`end_mis_weight`), to a streaming `Resampler`. Twin of
 //! glsl/restir_candidates.glsl, which the initial pass runs; docs/restir.md describes the pass.
 
@@ -10,7 +11,7 @@ use crate::scene::Scene;
 use crate::shading::bsdf::{bsdf_eval_pdf, LOBE_DELTA, LOBE_NONE};
 use crate::shading::gris::{resampler_offer, target_function, Resampler};
 use crate::shading::path_record::PathRecord;
-use crate::shading::rng::{rng_uniform4, STREAM_RESAMPLE};
+use crate::shading::rng::{rng_uniform4, STREAM_DIRECTIONAL, STREAM_RESAMPLE};
 use crate::shading::sampling::balance_heuristic;
 use crate::shading::shift::{
     bsdf_vertex, end_emission, end_mis_weight, nee_vertex, record_path, vertex_is_escaped, vertex_is_punctual, vertex_shading, visible,
@@ -32,6 +33,7 @@ pub struct CandidateCounts {
 struct TracedCandidate {
     count: usize,
     nee_end: bool,
+    nee_directional: u32,
     light: Vertex,
     nee_weight: Vec3,
     end_weight: f32,
@@ -65,6 +67,7 @@ fn record_chosen(
     p.lobes.truncate(c.count - 1);
     p.weights.truncate(c.count - 1);
     p.nee_end = c.nee_end;
+    p.nee_directional = c.nee_directional;
     if c.nee_end {
         // The NEE step replaces the BSDF step at x_{count-1}, which may not have been taken.
         p.vertices.truncate(c.count - 1);
@@ -85,9 +88,10 @@ fn record_chosen(
     }
 }
 
-/// The NEE candidate at x_i (material `m` and shading normal `ns`, leaving towards `wo`, after the prefix weight
-/// `prefix` of x1..x_{i-1}): the path x1..x_i plus the light vertex NEE chooses with the path's
-/// random numbers; `None` if it carries no light.
+/// The NEE candidate of technique `t` at x_i (material `m` and shading normal `ns`, leaving
+/// towards `wo`, after the prefix weight `prefix` of x1..x_{i-1}): the path x1..x_i plus the
+/// light vertex NEE takes with it (`nee_vertex`: the drawn light for 0, directional light t - 1
+/// otherwise); `None` if it carries no light.
 #[allow(clippy::too_many_arguments)]
 fn nee_candidate(
     scene: &Scene,
@@ -97,9 +101,10 @@ fn nee_candidate(
     wo: Vec3,
     seed: u32,
     i: usize,
+    t: u32,
     prefix: Vec3,
 ) -> Option<TracedCandidate> {
-    let (ls, light) = nee_vertex(scene, x, seed, i)?;
+    let (ls, light) = nee_vertex(scene, x, seed, i, t)?;
     let (f_cos, bsdf_pdf) = bsdf_eval_pdf(m, x.normal, ns, wo, ls.dir);
     if f_cos.max_element() <= 0.0 || !visible(scene, x, &light) {
         return None;
@@ -115,6 +120,7 @@ fn nee_candidate(
     (contribution.max_element() > 0.0).then_some(TracedCandidate {
         count: i + 1,
         nee_end: true,
+        nee_directional: t,
         light,
         nee_weight: weight,
         end_weight,
@@ -141,6 +147,7 @@ pub fn stream_path_candidates(
         camera,
         vertices: vec![y1],
         nee_end: false,
+        nee_directional: 0,
         lobes: Vec::new(),
         weights: Vec::new(),
         contribution: Vec3::ZERO,
@@ -157,9 +164,17 @@ pub fn stream_path_candidates(
         let wo = (prev_pos - x.pos).normalize();
         let (m, ns) = vertex_shading(scene, &x);
         let u = rng_uniform4(seed, i as u32, STREAM_RESAMPLE);
-        if let Some(c) = nee_candidate(scene, &x, &m, ns, wo, seed, i, prefix) {
-            if offer_candidate(s, &mut counts, c.contribution, scale, u.x) {
-                chosen = Some(c);
+        // NEE's techniques at x: the drawn light, then every directional light.
+        for t in 0..=scene.directional_count {
+            if let Some(c) = nee_candidate(scene, &x, &m, ns, wo, seed, i, t, prefix) {
+                let u_offer = if t == 0 {
+                    u.x
+                } else {
+                    rng_uniform4(seed, i as u32, STREAM_DIRECTIONAL + t - 1).x
+                };
+                if offer_candidate(s, &mut counts, c.contribution, scale, u_offer) {
+                    chosen = Some(c);
+                }
             }
         }
         let Some((b, next)) = bsdf_vertex(scene, &x, wo, &m, ns, seed, i) else {
@@ -177,6 +192,7 @@ pub fn stream_path_candidates(
                 chosen = Some(TracedCandidate {
                     count: i + 1,
                     nee_end: false,
+                    nee_directional: 0,
                     light: next,
                     nee_weight: Vec3::ZERO,
                     end_weight,

@@ -1,14 +1,15 @@
 //! Next-event estimation: the twin of glsl/lights.glsl. Lights are chosen by their likely
-//! contribution at the shading point (the light tree, src/shading/light_tree.rs); punctual
-//! lights (KHR_lights_punctual) are chosen beside emissive triangles, and a sample of one is a
-//! delta: its `pdf` is the discrete probability of choosing the light, its `radiance` the
-//! irradiance-like I·falloff/d² (or E), and MIS gives it weight 1.
+//! contribution at the shading point (the light tree, src/shading/light_tree.rs); point and spot
+//! lights (KHR_lights_punctual) are chosen beside emissive triangles, and directional lights are
+//! not chosen but taken at every vertex ([`sample_directional`]). A sample of a punctual light
+//! is a delta: its `pdf` is the discrete probability of choosing the light (1 for a directional
+//! one), its `radiance` the irradiance-like I·falloff/d² (or E), and MIS gives it weight 1.
 
 use glam::{Vec2, Vec3};
 
 use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use crate::scene::{PunctualKind, PunctualLight, Scene};
-use crate::shading::light_tree::{light_select, light_select_pmf};
+use crate::shading::light_tree::{directional_row, light_select, light_select_pmf};
 use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
 /// A next-event-estimation sample from a shading point (twin of GLSL `LightSample`,
@@ -175,7 +176,7 @@ pub fn sample_light(scene: &Scene, p: Vec3, n: Vec3, u: Vec3) -> LightSample {
             triangle: NO_EMITTER,
         };
     }
-    if scene.emitters.is_empty() {
+    if scene.emitters.len() as u32 == scene.directional_count {
         return none;
     }
     let u_select = (u.x - p_env) / (1.0 - p_env);
@@ -214,5 +215,20 @@ pub fn sample_light(scene: &Scene, p: Vec3, n: Vec3, u: Vec3) -> LightSample {
         radiance: emitted_radiance(scene, e.triangle, b, -dir),
         pdf: emitter_area_pdf(scene, pmf, e.triangle, dir, dist),
         triangle: e.triangle,
+    }
+}
+
+/// The sample of directional light `k` (`k` < `scene.directional_count`) that NEE adds at every
+/// vertex beside [`sample_light`]'s: towards the light, at infinity, its irradiance E, with
+/// probability 1. Twin of GLSL `sample_directional`.
+pub fn sample_directional(scene: &Scene, k: u32) -> LightSample {
+    let id = scene.emitters[directional_row(scene, k) as usize].triangle;
+    let (dir, dist, radiance) = punctual_arrival(&scene.lights[(id & !PUNCTUAL_LIGHT_BIT) as usize], Vec3::ZERO);
+    LightSample {
+        dir,
+        dist,
+        radiance,
+        pdf: 1.0,
+        triangle: id,
     }
 }

@@ -15,6 +15,7 @@ const LOBE_BITS: u32 = 5;
 const INFO_LENGTH_MASK: u32 = 0xf;
 const INFO_RC_SHIFT: u32 = 4;
 const INFO_NEE_END: u32 = 1 << 8;
+const INFO_DIRECTIONAL_SHIFT: u32 = 9;
 
 /// A reservoir's path sample (glsl/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
 /// GPU split into [`crate::gpu_types::ReservoirHead`] and [`crate::gpu_types::ReservoirTail`]).
@@ -26,7 +27,9 @@ pub struct PathRecord {
     /// The path's random-number key ([`crate::shading::rng::path_seed`]): random replay
     /// regenerates the path from it.
     pub seed: u32,
-    /// Bits 0-3: the length k; bits 4-7: the reconnection index r (0: none); bit 8: NEE end.
+    /// Bits 0-3: the length k; bits 4-7: the reconnection index r (0: none); bit 8: NEE end;
+    /// bits 9-31: which NEE technique made the end (0: the light NEE draws; k + 1: directional
+    /// light k, which NEE takes at every vertex).
     pub info: u32,
     /// The lobe sampled at x1..x_{k-1}, 5 bits each (LOBE_NONE where NEE chose the next vertex).
     pub lobes: u32,
@@ -53,9 +56,13 @@ pub struct PathRecord {
 
 impl PathRecord {
     /// The `info` word for a path of `length` vertices, reconnection index r (`None`: no
-    /// reconnection vertex) and end type. Twin of GLSL `pack_info`.
-    pub fn pack_info(length: usize, reconnection: Option<usize>, nee_end: bool) -> u32 {
-        length as u32 | (reconnection.unwrap_or(0) as u32) << INFO_RC_SHIFT | if nee_end { INFO_NEE_END } else { 0 }
+    /// reconnection vertex), end type and NEE technique (`nee_directional`: 0 for the drawn
+    /// light, k + 1 for directional light k). Twin of GLSL `pack_info`.
+    pub fn pack_info(length: usize, reconnection: Option<usize>, nee_end: bool, nee_directional: u32) -> u32 {
+        length as u32
+            | (reconnection.unwrap_or(0) as u32) << INFO_RC_SHIFT
+            | if nee_end { INFO_NEE_END } else { 0 }
+            | nee_directional << INFO_DIRECTIONAL_SHIFT
     }
 
     /// The `lobes` word: `lobes[i]` (a `LOBE_*` value below 2⁵) in bits 5i..5i+4, for x1 onwards.
@@ -85,6 +92,12 @@ pub fn record_reconnection_index(r: &PathRecord) -> Option<usize> {
 /// Whether NEE chose the path's last vertex.
 pub fn record_nee_end(r: &PathRecord) -> bool {
     r.info & INFO_NEE_END != 0
+}
+
+/// Which NEE technique made the path's end: 0 for the light NEE draws, k + 1 for directional
+/// light k (always 0 when the end is not NEE's).
+pub fn record_nee_directional(r: &PathRecord) -> u32 {
+    r.info >> INFO_DIRECTIONAL_SHIFT
 }
 
 /// The lobe sampled at x_i (1-based).

@@ -12,6 +12,9 @@ pub const STREAM_BSDF: u32 = 1;
 pub const STREAM_LIGHT: u32 = 2;
 /// ReSTIR's choices among candidates, keyed by a pass seed.
 pub const STREAM_RESAMPLE: u32 = 3;
+/// ReSTIR's choice of directional light k's NEE candidate at a vertex: stream
+/// `STREAM_DIRECTIONAL + k` (x).
+pub const STREAM_DIRECTIONAL: u32 = 4;
 
 /// The 4D permuted congruential hash of Jarzynski and Olano (JCGT 2020).
 pub fn pcg4d(v: UVec4) -> UVec4 {

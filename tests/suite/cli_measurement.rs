@@ -43,6 +43,26 @@ fn cli_reference_and_profile_write_their_files() {
     assert_eq!(code, 0, "{stderr}");
     let csv = std::fs::read_to_string(dir.join("passes.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3 * 4, "{csv}");
+    // Each pass's time also in path-tracer samples: ms over one ratio shared by every row.
+    let rows: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<f64> = l.split(',').skip(2).map(|v| v.parse().unwrap()).collect();
+            (f[0], f[1])
+        })
+        .collect();
+    let longest = rows.iter().copied().fold((0.0, 0.0), |a, r| if r.0 > a.0 { r } else { a });
+    let ms_per_sample = longest.0 / longest.1;
+    assert!(ms_per_sample > 0.0 && ms_per_sample.is_finite(), "{csv}");
+    for (ms, samples) in &rows {
+        // Both columns are rounded to 4 decimals.
+        assert!(
+            (samples * ms_per_sample - ms).abs() < 1e-3 * ms + 1e-4 * (ms_per_sample + 1.0),
+            "{csv}"
+        );
+    }
+    assert!(stdout.contains("GPU ms per sample per pixel"), "{stdout}");
     let trace: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("trace.json")).unwrap()).unwrap();
     assert_eq!(trace["traceEvents"].as_array().unwrap().len(), 12);
     assert!(std::fs::read_to_string(dir.join("passes.svg")).unwrap().starts_with("<svg"));
@@ -76,6 +96,7 @@ fn cli_compare_writes_results_charts_and_strip() {
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 4, "{csv}");
+    let spp = |r: &Vec<&str>| r[2].trim_start_matches("spp=").parse::<u32>().unwrap();
     for row in &rows {
         let rel_mse: f64 = row[4].parse().unwrap();
         let gpu_ms: f64 = row[3].parse().unwrap();
@@ -86,9 +107,15 @@ fn cli_compare_writes_results_charts_and_strip() {
         // Two trials of different seeds give a spread.
         let stderr_of_mean: f64 = row[10].parse().unwrap();
         assert!(stderr_of_mean > 0.0 && stderr_of_mean < rel_mse, "relMSE standard error: {row:?}");
+        let (mape, flip, pt_samples): (f64, f64, f64) = (row[11].parse().unwrap(), row[12].parse().unwrap(), row[13].parse().unwrap());
+        assert!(mape > 0.0 && mape.is_finite(), "MAPE: {row:?}");
+        assert!(flip > 0.0 && flip < 1.0, "HDR-FLIP: {row:?}");
+        assert!(pt_samples > 0.0 && pt_samples.is_finite(), "frame in path-tracer samples: {row:?}");
     }
+    // The path tracer's frame of n samples costs at least about n samples.
+    let pt_samples = |r: &Vec<&str>| r[13].parse::<f64>().unwrap();
+    assert!(pt_samples(&rows[1]) >= 0.7 * spp(&rows[1]) as f64, "{csv}");
     // A larger budget buys the path tracer more samples per frame.
-    let spp = |r: &Vec<&str>| r[2].trim_start_matches("spp=").parse::<u32>().unwrap();
     assert!(rows[0][0] == "pt" && rows[1][0] == "pt" && spp(&rows[1]) > spp(&rows[0]), "{csv}");
     assert!(rows[2][2].starts_with("reservoirs="), "{csv}");
     // Each budget gets its equal-time lines: the ratio, or, when a shared machine made a

@@ -7,7 +7,9 @@ use std::collections::HashSet;
 
 use glam::Vec3;
 use restir_pt::scene::Scene;
-use restir_pt::shading::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord};
+use restir_pt::shading::path_record::{
+    record_length, record_lobe, record_nee_directional, record_nee_end, record_reconnection_index, PathRecord,
+};
 use restir_pt::shading::shift::*;
 
 use crate::common::TestRng;
@@ -67,7 +69,22 @@ pub(crate) fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
         };
         let length = 2 + (r.uniform() * 5.0) as usize;
         let nee_end = r.uniform() < 0.5;
-        let base = generate_path(scene, scene.cameras[0].position, x1, r.next_u64() as u32, length, nee_end);
+        // NEE's technique: the drawn light, or one of the directional lights it always takes.
+        let techniques = 1 + scene.directional_count;
+        let nee_directional = if nee_end {
+            ((r.uniform() * techniques as f32) as u32).min(techniques - 1)
+        } else {
+            0
+        };
+        let base = generate_path(
+            scene,
+            scene.cameras[0].position,
+            x1,
+            r.next_u64() as u32,
+            length,
+            nee_end,
+            nee_directional,
+        );
         if let Some((base, record)) = base
             .and_then(|b| Some((record_path(scene, &params, &b)?, b)))
             .map(|(rec, b)| (b, rec))
@@ -319,7 +336,7 @@ fn shift_hybrid_jacobian_finite_difference() {
 #[test]
 fn shift_path_record_is_80_bytes_and_packs_its_fields() {
     assert_eq!(std::mem::size_of::<PathRecord>(), 80);
-    let info = PathRecord::pack_info(6, Some(3), true);
+    let info = PathRecord::pack_info(6, Some(3), true, 2);
     let lobes = PathRecord::pack_lobes(&[1, 2, 4 | 8, 16 | 4, 0]);
     let record = PathRecord {
         info,
@@ -327,12 +344,17 @@ fn shift_path_record_is_80_bytes_and_packs_its_fields() {
         ..Default::default()
     };
     assert_eq!(
-        (record_length(&record), record_reconnection_index(&record), record_nee_end(&record)),
-        (6, Some(3), true)
+        (
+            record_length(&record),
+            record_reconnection_index(&record),
+            record_nee_end(&record),
+            record_nee_directional(&record)
+        ),
+        (6, Some(3), true, 2)
     );
     assert_eq!((1..=5).map(|i| record_lobe(&record, i)).collect::<Vec<_>>(), vec![1, 2, 12, 20, 0]);
     let unconnected = PathRecord {
-        info: PathRecord::pack_info(2, None, false),
+        info: PathRecord::pack_info(2, None, false, 0),
         ..Default::default()
     };
     assert_eq!(record_reconnection_index(&unconnected), None);
@@ -398,7 +420,15 @@ fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths()
                 }
             }
             // A replay whose regenerated path has another length or other lobes must fail.
-            let replayed = generate_path(&scene, camera, y1, case.base.seed, case.base.length(), case.base.nee_end);
+            let replayed = generate_path(
+                &scene,
+                camera,
+                y1,
+                case.base.seed,
+                case.base.length(),
+                case.base.nee_end,
+                case.base.nee_directional,
+            );
             if replayed.as_ref().is_none_or(|y| y.lobes != case.base.lobes) {
                 check(
                     &shift_random_replay(&scene, &params, &case.record, camera, y1),

@@ -34,14 +34,22 @@ pub use reconnection::*;
 pub use vertex::*;
 
 use crate::scene::Scene;
-use crate::shading::path_record::{record_length, record_nee_end, record_reconnection_index, PathRecord};
+use crate::shading::path_record::{record_length, record_nee_directional, record_nee_end, record_reconnection_index, PathRecord};
 use path::{shift_failed, shift_ok};
 use reconnection::reconnect_at;
 
 /// Random replay: regenerate the record's random numbers from the target's primary hit. Valid
-/// only with the same length, end type and lobes at every vertex; Jacobian 1.
+/// only with the same length, end type (and NEE technique) and lobes at every vertex; Jacobian 1.
 pub fn shift_random_replay(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
-    let replayed = generate_path(scene, camera, y1, base.seed, record_length(base), record_nee_end(base));
+    let replayed = generate_path(
+        scene,
+        camera,
+        y1,
+        base.seed,
+        record_length(base),
+        record_nee_end(base),
+        record_nee_directional(base),
+    );
     match replayed.as_ref().and_then(|y| Some((y, record_path(scene, params, y)?))) {
         Some((y, record)) if record.lobes == base.lobes => shift_ok(record, 1.0, y.vertices.clone()),
         _ => shift_failed(),

@@ -13,7 +13,7 @@ use crate::gpu_types::{Material, NO_EMITTER};
 use crate::scene::bvh::{trace_closest, NO_HIT};
 use crate::scene::Scene;
 use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, BsdfSample, LOBE_DELTA, LOBE_NONE};
-use crate::shading::lights::{is_punctual_light, sample_light, LightSample};
+use crate::shading::lights::{is_punctual_light, sample_directional, sample_light, LightSample};
 use crate::shading::path_record::PathRecord;
 use crate::shading::ray_offset::offset_ray_origin;
 use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
@@ -30,6 +30,9 @@ pub struct Path {
     pub vertices: Vec<Vertex>,
     /// True if xk is a light sample taken by NEE at x_{k-1}; false if BSDF sampling hit it.
     pub nee_end: bool,
+    /// NEE's technique at the end: 0 for the light it draws (`sample_light`), k + 1 for
+    /// directional light k, which it takes at every vertex (`sample_directional`).
+    pub nee_directional: u32,
     /// The lobe sampled at x1..x_{k-1} (LOBE_NONE where NEE chose the next vertex).
     pub lobes: Vec<u32>,
     /// f_s |cos| / p at x1..x_{k-1}.
@@ -102,10 +105,19 @@ pub fn reconnection_index(scene: &Scene, path: &Path, params: &ShiftParams) -> O
 
 /// Regenerates the path of `length` vertices from the primary hit `x1` seen from `camera`, with
 /// the random numbers of `seed`: BSDF sampling at x1..x_{k-2} and, at x_{k-1}, NEE when
-/// `nee_end`, else BSDF sampling. `None` if the path ends early (a miss, a failed sample, an
-/// occluded light sample) or its end emits nothing towards it.
-pub fn generate_path(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: usize, nee_end: bool) -> Option<Path> {
-    let mut path = trace_vertices(scene, camera, x1, seed, length, nee_end)?;
+/// `nee_end` (with technique `nee_directional`, as [`Path::nee_directional`]), else BSDF
+/// sampling. `None` if the path ends early (a miss, a failed sample, an occluded light sample)
+/// or its end emits nothing towards it.
+pub fn generate_path(
+    scene: &Scene,
+    camera: Vec3,
+    x1: Vertex,
+    seed: u32,
+    length: usize,
+    nee_end: bool,
+    nee_directional: u32,
+) -> Option<Path> {
+    let mut path = trace_vertices(scene, camera, x1, seed, length, nee_end, nee_directional)?;
     finish_path(scene, &mut path).then_some(path)
 }
 
@@ -133,12 +145,21 @@ fn finish_path(scene: &Scene, path: &mut Path) -> bool {
 }
 
 /// The vertices, lobes and weights of `generate_path`, without the emission at the end.
-pub(super) fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32, length: usize, nee_end: bool) -> Option<Path> {
+pub(super) fn trace_vertices(
+    scene: &Scene,
+    camera: Vec3,
+    x1: Vertex,
+    seed: u32,
+    length: usize,
+    nee_end: bool,
+    nee_directional: u32,
+) -> Option<Path> {
     let mut path = Path {
         seed,
         camera,
         vertices: vec![x1],
         nee_end,
+        nee_directional,
         lobes: Vec::new(),
         weights: Vec::new(),
         contribution: Vec3::ZERO,
@@ -154,7 +175,7 @@ pub(super) fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32,
         let wo = (prev_pos - x.pos).normalize();
         let (m, ns) = vertex_shading(scene, &x);
         let (next, lobe, weight) = if i + 1 == length && nee_end {
-            let (ls, end) = nee_vertex(scene, &x, seed, i)?;
+            let (ls, end) = nee_vertex(scene, &x, seed, i, nee_directional)?;
             if !visible(scene, &x, &end) {
                 return None;
             }
@@ -171,10 +192,15 @@ pub(super) fn trace_vertices(scene: &Scene, camera: Vec3, x1: Vertex, seed: u32,
     Some(path)
 }
 
-/// The light point NEE at x_i chooses with the path's random numbers, and its light sample;
-/// `None` if none can be chosen. Visibility is left to the caller.
-pub(crate) fn nee_vertex(scene: &Scene, x: &Vertex, seed: u32, i: usize) -> Option<(LightSample, Vertex)> {
-    let ls = sample_light(scene, x.pos, x.normal, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate());
+/// The light point NEE at x_i takes with technique `directional` (directional light
+/// `directional` - 1, or for 0 the light it draws with the path's random numbers), and its
+/// light sample; `None` if none can be chosen. Visibility is left to the caller.
+pub(crate) fn nee_vertex(scene: &Scene, x: &Vertex, seed: u32, i: usize, directional: u32) -> Option<(LightSample, Vertex)> {
+    let ls = if directional > 0 {
+        sample_directional(scene, directional - 1)
+    } else {
+        sample_light(scene, x.pos, x.normal, rng_uniform4(seed, i as u32, STREAM_LIGHT).truncate())
+    };
     if !(ls.pdf > 0.0) {
         return None;
     }

@@ -27,7 +27,7 @@ pub fn record_path(scene: &Scene, params: &ShiftParams, path: &Path) -> Option<P
     let r = reconnection_index(scene, path, params);
     let mut record = PathRecord {
         seed: path.seed,
-        info: PathRecord::pack_info(k, r, path.nee_end),
+        info: PathRecord::pack_info(k, r, path.nee_end, path.nee_directional),
         lobes: PathRecord::pack_lobes(&path.lobes),
         rc_triangle: NO_HIT,
         rc_pdf: 1.0,
@@ -177,7 +177,7 @@ fn record_vertex(scene: &Scene, triangle: u32, pos: [f32; 3]) -> Vertex {
 /// Replays y1..y_{r-1} and reconnects y_{r-1} to the record's x_r (1-based indices).
 pub(super) fn reconnect_at(scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex, r: usize) -> ShiftResult {
     // The replayed prefix y1..y_{r-1}: BSDF sampling only, whatever the base's end type.
-    let Some(prefix) = trace_vertices(scene, camera, y1, base.seed, r - 1, false) else {
+    let Some(prefix) = trace_vertices(scene, camera, y1, base.seed, r - 1, false, 0) else {
         return shift_failed();
     };
     if (1..r - 1).any(|i| prefix.lobes[i - 1] != record_lobe(base, i)) {

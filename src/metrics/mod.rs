@@ -1,7 +1,10 @@
-//! Image error metrics against a reference: relMSE (also trimmed), MAPE, MSE, energy and
-//! frame-to-frame flicker.
+//! Image error metrics against a reference: relMSE (also trimmed), MAPE, MSE, energy,
+//! frame-to-frame flicker, and LDR- and HDR-ꟻLIP.
 
 use glam::Vec3;
+
+mod flip;
+pub use flip::{hdr_flip, hdr_flip_exposures, hdr_flip_map, ldr_flip_map, PIXELS_PER_DEGREE};
 
 /// Guards relMSE's denominator where the reference is black (the usual 1e-2 of the literature).
 pub const REL_MSE_EPSILON: f32 = 1e-2;
