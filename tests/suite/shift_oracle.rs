@@ -126,7 +126,12 @@ struct Tally {
     excluded: usize,
     compared: usize,
     beyond_1e4: usize,
+    grazing: usize,
 }
+
+/// Below this cosine between the last edge and the end vertex's normal, a path's contribution
+/// is compared no further (see `check_one`).
+const GRAZING_END_COSINE: f32 = 1e-3;
 
 /// One job's GLSL output `g` against the Rust twin's result.
 fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32, tally: &mut Tally) {
@@ -173,6 +178,16 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
     ] {
         assert!(close(a, b, 1e-3), "{what}: {field} GLSL {a} vs Rust {b}");
     }
+    // f(X) is proportional to the cosine at the path's end vertex, and that cosine's absolute
+    // rounding follows the rounding of the vertex positions (about 1e-7 of the edge length on
+    // each side): its relative error grows as 1e-7 / cos. Below GRAZING_END_COSINE (a light met
+    // within 0.06 degrees of edge-on) that passes 1e-4, so such ends are counted, not compared.
+    let n = rust.vertices.len();
+    let grazing = n >= 2 && {
+        let (a, b) = (&rust.vertices[n - 2], &rust.vertices[n - 1]);
+        b.normal.dot((b.pos - a.pos).normalize_or_zero()).abs() < GRAZING_END_COSINE
+    };
+    tally.grazing += grazing as usize;
     let scale = rust.contribution.max_element();
     let worst = (0..3)
         .map(|c| (g[5][c] - rust.contribution[c]).abs() / scale)
@@ -183,12 +198,12 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
     // most 0.1% beyond 1e-4, counted; the others to 1e-4.
     let bound = if kind == Kind::RandomReplay { 1e-3 } else { 1e-4 };
     assert!(
-        worst <= bound,
+        grazing || worst <= bound,
         "{what}: contribution GLSL {} vs Rust {} ({worst:e})",
         g[5],
         rust.contribution
     );
-    tally.beyond_1e4 += (worst > 1e-4) as usize;
+    tally.beyond_1e4 += (!grazing && worst > 1e-4) as usize;
     assert_eq!(g[0].z as usize, rust.vertices.len(), "{what}: vertex count");
     for (v, rv) in rust.vertices.iter().enumerate() {
         let gv = g[6 + v].truncate();
@@ -204,7 +219,8 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
 /// them). Validity, the rebuilt vertices (within 1e-4 of the scene's extent), the Jacobian and
 /// the contribution agree within 1e-4 relative (random replay: within 1e-3, and at most 0.1%
 /// beyond 1e-4), the record's cached terms within 1e-3. Inputs within 1e-3 of the distance or
-/// roughness threshold are excluded and counted (at most 1%).
+/// roughness threshold are excluded and counted (at most 1%); contributions of paths whose end
+/// meets its last edge below `GRAZING_END_COSINE` are counted, not compared (at most 0.3%).
 fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
     let function = if inverted { "inverse" } else { "shift" };
     for name in ["cornell", "cornell-glossy", "glass", "near-field", NORMAL_MAPPED_BOX] {
@@ -234,8 +250,9 @@ fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
             excluded,
             compared,
             beyond_1e4,
+            grazing,
         } = tally;
-        eprintln!("{name} {function} {kind:?}: {compared} valid shifts compared, {excluded} within 1e-3 of a threshold excluded, {beyond_1e4} contributions beyond 1e-4");
+        eprintln!("{name} {function} {kind:?}: {compared} valid shifts compared, {excluded} within 1e-3 of a threshold excluded, {beyond_1e4} contributions beyond 1e-4, {grazing} grazing ends");
         // The normal-mapped box's replayed contributions also go through bilinear normal-map
         // lookups, whose slope turns the regenerated positions' rounding into normal, and so
         // contribution, differences: measured 5 of 4628 (0.11%) beyond 1e-4, every one within
@@ -246,6 +263,9 @@ fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
             "{name} {kind:?}: {beyond_1e4} contributions beyond 1e-4"
         );
         assert!(excluded * 100 <= jobs.len(), "{name} {kind:?}: {excluded} exclusions");
+        // A light sampled by area meets its edges at a cosine spread near uniformly over [0, 1],
+        // so about 0.1% of ends fall below GRAZING_END_COSINE; three times that is held.
+        assert!(grazing * 1000 <= 3 * compared, "{name} {kind:?}: {grazing} grazing ends");
         assert!(compared > BASE_PATHS / 10, "{name} {kind:?}: only {compared} valid shifts");
     }
 }
