@@ -2,7 +2,7 @@
 // frame parameters and the scene arrays that traversal reads). Only kernels of a scene that has
 // them declare these bindings: SCENE_SURFACE (vertex normals, tangents, texture coordinates) and
 // SCENE_TEXTURES (textures, which need the coordinates), set by src/render/scene_gpu.rs.
-// Twins: src/surface.rs (TriangleSurface), src/texture.rs (TextureHeader, TextureSlot,
+// Twins: src/shading/surface.rs (TriangleSurface), src/shading/texture.rs (TextureHeader, TextureSlot,
 // MaterialTextures).
 #ifndef SURFACE_BINDINGS_GLSL
 #define SURFACE_BINDINGS_GLSL

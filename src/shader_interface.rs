@@ -135,9 +135,9 @@ binding_family! {
     /// what traversal reads; these are read only at hits. Oracle kernels that bind everything
     /// in set 0 move the family there (`SURFACE_SET`, `SURFACE_BINDING` in the GLSL).
     SurfaceBinding, "SURFACE_BINDING_", set 1 {
-        /// `TriangleSurface` per triangle (src/surface.rs).
+        /// `TriangleSurface` per triangle (src/shading/surface.rs).
         SurfaceAttributes = 0,
-        /// `MaterialTextures` per material (src/texture.rs); this and the next two only with
+        /// `MaterialTextures` per material (src/shading/texture.rs); this and the next two only with
         /// textures.
         MaterialTextureTable = 1,
         /// `TextureHeader` per texture.

@@ -1,5 +1,5 @@
-//! What a hit on the scene sees: its surface (src/surface.rs) and its material with textures
-//! applied (src/texture.rs). Host counterparts of `surface_at`, `material_at` and
+//! What a hit on the scene sees: its surface (src/shading/surface.rs) and its material with textures
+//! applied (src/shading/texture.rs). Host counterparts of `surface_at`, `material_at` and
 //! `normal_mapped` in glsl/surface.glsl and glsl/texture.glsl.
 
 use glam::{Vec2, Vec3};

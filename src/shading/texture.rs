@@ -2,7 +2,7 @@
 //! nearest filtering, sRGB decoding) done by hand, and the material a hit sees once its textures
 //! apply. Twin of glsl/texture.glsl: `texture_lookup`, `texture_coordinates`,
 //! `textured_material` and `normal_mapped` have GLSL functions of the same names, compared in
-//! tests/suite/texture_oracle.rs. Why a buffer rather than sampled images: docs/textures.md.
+//! tests/suite/surface_oracle.rs. Why a buffer rather than sampled images: docs/textures.md.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};

@@ -1,4 +1,4 @@
-//! GLSL surface.glsl, texture.glsl and shading_frame.glsl against src/surface.rs, src/texture.rs
+//! GLSL surface.glsl, texture.glsl and shading_frame.glsl against src/shading/surface.rs, src/shading/texture.rs
 //! and src/scene/hit_surface.rs: surface_at, triangle_bary, texture_lookup, texture_coordinates,
 //! textured_material (with emission_coverage), normal_mapped, texture_tangent_frame (the normal
 //! texture's frame turned and mirrored with its transform), vertex_color, shading_normal and

@@ -1,4 +1,4 @@
-//! Textured scenes made by the generator (src/gltf_writer/textures.rs): the textured furnace,
+//! Textured scenes made by the generator (src/scene/gltf_writer/textures.rs): the textured furnace,
 //! and the loader's reading of samplers, texture coordinate sets and KHR_texture_transform.
 
 use std::sync::atomic::AtomicBool;
