@@ -187,16 +187,21 @@ pub fn compile_kernel_cached_in(name: &str, defines: &[(&str, &str)], dir: &Path
     Ok((spirv, false))
 }
 
-/// GLSL to SPIR-V with shaderc: Vulkan 1.2, SPIR-V 1.5, optimised, with debug information
-/// (names for the validation layer's messages and for `reflect`).
+/// GLSL to SPIR-V with shaderc: Vulkan 1.2, SPIR-V 1.5, unoptimised, with glslang's names (for
+/// the validation layer's messages and for `reflect`) and no line information.
+///
+/// spirv-opt is left out because the driver optimises again: lavapipe lowers SPIR-V to NIR and
+/// runs NIR's and LLVM's optimisers on it, and on the bundled scenes the unoptimised SPIR-V
+/// gives bit-identical images while shaderc's `Performance` level spent 1 to 3 s of CPU per
+/// ReSTIR kernel, half of a cold start-up (docs/performance.md, "Start-up"). Without
+/// optimisation glslang keeps `OpName`s without `-g`, which would only add line records.
 fn compile_glsl(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
     let source = glsl_source(name).ok_or_else(|| anyhow!("no GLSL kernel named {name} under glsl/"))?;
     let compiler = shaderc::Compiler::new().map_err(|e| anyhow!("cannot initialise shaderc: {e}"))?;
     let mut options = shaderc::CompileOptions::new().map_err(|e| anyhow!("cannot create shaderc options: {e}"))?;
     options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
     options.set_target_spirv(shaderc::SpirvVersion::V1_5);
-    options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-    options.set_generate_debug_info();
+    options.set_optimization_level(shaderc::OptimizationLevel::Zero);
     for (k, v) in defines {
         options.add_macro_definition(k, Some(v));
     }
