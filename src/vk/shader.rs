@@ -191,10 +191,11 @@ pub fn compile_kernel_cached_in(name: &str, defines: &[(&str, &str)], dir: &Path
 /// the validation layer's messages and for `reflect`) and no line information.
 ///
 /// spirv-opt is left out because the driver optimises again: lavapipe lowers SPIR-V to NIR and
-/// runs NIR's and LLVM's optimisers on it, and on the bundled scenes the unoptimised SPIR-V
-/// gives bit-identical images while shaderc's `Performance` level spent 1 to 3 s of CPU per
-/// ReSTIR kernel, half of a cold start-up (docs/performance.md, "Start-up"). Without
-/// optimisation glslang keeps `OpName`s without `-g`, which would only add line records.
+/// runs NIR's and LLVM's optimisers on it. The unoptimised SPIR-V gave bit-identical images on
+/// the untextured scenes tried and images within 5e-7 relative on a textured one (Avocado),
+/// while shaderc's `Performance` level spent 1 to 3 s of CPU per ReSTIR kernel, half of a cold
+/// start-up (docs/performance.md, "Start-up"). Unoptimised, glslang keeps its `OpName`s
+/// without `-g`, which would only add line records.
 fn compile_glsl(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
     let source = glsl_source(name).ok_or_else(|| anyhow!("no GLSL kernel named {name} under glsl/"))?;
     let compiler = shaderc::Compiler::new().map_err(|e| anyhow!("cannot initialise shaderc: {e}"))?;
