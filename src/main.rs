@@ -32,11 +32,12 @@ enum Command {
     Info(app::InfoArgs),
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
     Bench(app::BenchArgs),
-    /// Path-trace a converged reference: mean EXR (--out) and variance EXR (<out>.variance.exr).
+    /// Path-trace a converged reference: mean EXR (--out NAME.exr) and variance EXR
+    /// (NAME.variance.exr).
     Reference(app::ReferenceArgs),
-    /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out) and variance
-    /// EXR (<out>.variance.exr): the images one `reference` process of the same seed and spp
-    /// writes, up to the order of floating-point sums.
+    /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out NAME.exr) and
+    /// variance EXR (NAME.variance.exr): the images one `reference` process of the same seed and
+    /// spp writes, up to the order of floating-point sums.
     Merge(app::MergeArgs),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
     Profile(app::ProfileArgs),
