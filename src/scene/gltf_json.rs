@@ -225,7 +225,8 @@ fn percent_decode(uri: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-/// Names the first external buffer file that does not exist (the crate's I/O error would not).
+/// Names the first external buffer file that does not exist or is shorter than its byteLength
+/// (the crate's errors would not).
 pub(super) fn check_external_buffers(json: &Value, base: Option<&Path>, path: &Path) -> Result<()> {
     let Some(buffers) = json.get("buffers").and_then(Value::as_array) else {
         return Ok(());
@@ -248,6 +249,16 @@ pub(super) fn check_external_buffers(json: &Value, base: Option<&Path>, path: &P
             bail!(problem(
                 path,
                 format!("buffer {i}: external file {uri:?} not found (looked for {})", file.display())
+            ));
+        }
+        // A truncated .bin is named here: the gltf crate's own message names neither the buffer's
+        // file nor the glTF.
+        let declared = buffer.get("byteLength").and_then(Value::as_u64).unwrap_or(0);
+        let held = std::fs::metadata(&file).map_or(0, |m| m.len());
+        if held < declared {
+            bail!(problem(
+                path,
+                format!("buffer {i}: external file {uri:?} holds {held} bytes, fewer than its byteLength {declared} (truncated?)")
             ));
         }
     }

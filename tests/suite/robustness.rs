@@ -35,6 +35,38 @@ fn run_with_deadline(args: &[&str], deadline: Duration) -> (i32, String) {
     }
 }
 
+/// A .bin shorter than its buffer's byteLength: one error line naming the glTF, the buffer's
+/// file and both sizes (the gltf crate's own message names neither file).
+#[test]
+fn robustness_truncated_external_buffer_names_its_file() {
+    let gltf = std::fs::read_to_string(repo_path("tests/data/bad/missing-bin.gltf")).unwrap();
+    assert!(gltf.contains("missing.bin"));
+    let path = temp_file("short-bin.gltf", gltf.replace("missing.bin", "short.bin").as_bytes());
+    std::fs::write(path.with_file_name("short.bin"), [0u8; 12]).unwrap();
+    let out = path.with_file_name("short.exr");
+    let args = [
+        "render",
+        path.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--method",
+        "pt",
+        "--spp",
+        "1",
+    ];
+    let (code, stderr) = run_with_deadline(&[&args[..], &["--out", out.to_str().unwrap()]].concat(), Duration::from_secs(60));
+    assert_eq!(code, 1, "{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{stderr}");
+    assert!(
+        errors[0].contains("short-bin.gltf") && errors[0].contains("\"short.bin\" holds 12 bytes") && errors[0].contains("byteLength"),
+        "{}",
+        errors[0]
+    );
+}
+
 #[test]
 fn robustness_bad_input_corpus_gives_clear_errors_or_warnings() {
     let dir = repo_path("tests/data/bad");
