@@ -15,7 +15,7 @@ use super::method_spec::{MethodRenderer, MethodSpec};
 use super::render_output::{compile_progress, print_compile_summary};
 use super::{finish_device, load_with_options, open_device};
 use restir_pt::metrics::quantile;
-use restir_pt::render::{RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_NAMES};
+use restir_pt::render::{PassTimes, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_COUNT, PASS_NAMES};
 use restir_pt::scene::camera_on_path;
 
 /// `restir-pt profile`.
@@ -43,10 +43,10 @@ pub struct ProfileArgs {
     pub device: DeviceArgs,
 }
 
-const PASS_COLOURS: [&str; 4] = ["#4c72b0", "#dd8452", "#55a868", "#c44e52"];
+const PASS_COLOURS: [&str; PASS_COUNT] = ["#4c72b0", "#dd8452", "#55a868", "#c44e52"];
 
 /// A stacked bar per frame, one colour per pass.
-fn stacked_bar_svg(times: &[[f64; 4]], title: &str) -> String {
+fn stacked_bar_svg(times: &[PassTimes], title: &str) -> String {
     let (w, h, left, bottom, top) = (720.0, 360.0, 60.0, 40.0, 40.0);
     let max = times.iter().map(|t| t.iter().sum::<f64>()).fold(0.0, f64::max).max(1e-9);
     let bar = (w - left - 20.0) / times.len() as f64;
@@ -93,7 +93,7 @@ fn stacked_bar_svg(times: &[[f64; 4]], title: &str) -> String {
 }
 
 /// Chrome trace events: frames one after another, passes one after another within a frame.
-fn chrome_trace(times: &[[f64; 4]]) -> serde_json::Value {
+fn chrome_trace(times: &[PassTimes]) -> serde_json::Value {
     let mut events = vec![];
     let mut clock_us = 0.0;
     for (f, t) in times.iter().enumerate() {
@@ -164,7 +164,7 @@ fn path_tracer_ms_per_sample(scene: &Arc<SceneGpu>, settings: &RenderSettings, c
 }
 
 /// Every frame's GPU ms per pass.
-fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirSettings, args: &ProfileArgs) -> Result<Vec<[f64; 4]>> {
+fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirSettings, args: &ProfileArgs) -> Result<Vec<PassTimes>> {
     let ctx = scene.ctx();
     if !ctx.info.timestamps_supported {
         bail!("{}: the device has no compute timestamps to profile with", ctx.info.name);
@@ -190,7 +190,7 @@ fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirS
 
 /// passes.csv, trace.json, passes.svg and the median/p95 table, each time also in path-tracer
 /// samples per pixel (`pt_ms` GPU ms each).
-fn write_outputs(args: &ProfileArgs, times: &[[f64; 4]], pt_ms: f64, title: &str) -> Result<()> {
+fn write_outputs(args: &ProfileArgs, times: &[PassTimes], pt_ms: f64, title: &str) -> Result<()> {
     let mut csv = String::from("frame,pass,gpu_ms,pt_samples\n");
     for (f, t) in times.iter().enumerate() {
         for (p, ms) in t.iter().enumerate() {

@@ -52,8 +52,14 @@ impl PassKernel {
     }
 }
 
+/// How many passes a frame has (each timed on its own).
+pub const PASS_COUNT: usize = 4;
+
 /// The passes of a frame, the names its GPU times are reported under.
-pub const PASS_NAMES: [&str; 4] = ["initial", "temporal", "spatial", "shade"];
+pub const PASS_NAMES: [&str; PASS_COUNT] = ["initial", "temporal", "spatial", "shade"];
+
+/// GPU milliseconds of each pass of one frame, in the order of `PASS_NAMES`.
+pub type PassTimes = [f64; PASS_COUNT];
 
 /// What a frame starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

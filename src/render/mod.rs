@@ -46,7 +46,7 @@ mod settings;
 mod surface_gpu;
 
 pub use counters::TraversalCounters;
-pub use frame_plan::{History, PassKernel, PASS_NAMES};
+pub use frame_plan::{History, PassKernel, PassTimes, PASS_COUNT, PASS_NAMES};
 pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir};

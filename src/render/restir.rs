@@ -9,7 +9,7 @@ use anyhow::{Context as _, Result};
 
 use self::buffers::RestirBuffers;
 use self::params::same_pose;
-use super::frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PASS_NAMES};
+use super::frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PassTimes, PASS_COUNT};
 use super::image_readback::AccumReadback;
 use super::reservoir_layers::ReservoirLayers;
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
@@ -34,9 +34,9 @@ const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record:
 /// What one ReSTIR PT frame ([`Restir::frame`]) took, and its counters.
 #[derive(Debug, Clone)]
 pub struct FrameStats {
-    /// GPU milliseconds per pass, indexed like [`PASS_NAMES`] (initial, temporal, spatial, shade;
+    /// GPU milliseconds per pass, indexed like [`PASS_NAMES`](super::PASS_NAMES) (initial, temporal, spatial, shade;
     /// about 0 for a pass the frame did not run); `None` where the device has no timestamp queries.
-    pub pass_ms: Option<[f64; 4]>,
+    pub pass_ms: Option<PassTimes>,
     /// Wall-clock milliseconds of the frame, parameter upload and counter readback included.
     pub wall_ms: f64,
     /// The kernels' counters for this frame (shifts, dropped candidates, non-finite values).
@@ -151,7 +151,7 @@ impl Restir {
             buffers,
             readback: AccumReadback::new(ctx, settings.width, settings.height, stats_bytes)?,
             scene_gpu: scene.clone(),
-            timer: PassTimer::new(ctx, PASS_NAMES.len() as u32)?,
+            timer: PassTimer::new(ctx, PASS_COUNT as u32)?,
             settings: settings.clone(),
             restir: restir.clone(),
             shift_params: scene.info().shift_params,
@@ -303,7 +303,7 @@ impl Restir {
             .submit_and_wait(|cmd| self.record_frame(cmd, &plan, accumulate))
             .context("ReSTIR PT frame")?;
         let counters = self.read_counters()?;
-        let pass_ms = self.timer.read_ms(PASS_NAMES.len() as u32)?.map(|t| [t[0], t[1], t[2], t[3]]);
+        let pass_ms = self.timer.read_ms(PASS_COUNT as u32)?.map(|t| std::array::from_fn(|p| t[p]));
         self.history = Some((plan.final_slot, frame_params));
         self.surface_slot = 1 - self.surface_slot;
         self.frame_index += 1;
