@@ -21,31 +21,41 @@ struct Cli {
     command: Option<Command>,
 }
 
+// Negative numbers parse as values everywhere, so that `--frames -1` is refused as an invalid
+// value of --frames rather than as an unknown argument.
 #[derive(Subcommand)]
 enum Command {
     /// Render a glTF scene (default: the built-in scenes/cornell.gltf) to EXR and PNG with ReSTIR
     /// PT (default: frames of a still camera averaged for 8 s of GPU time; --frames N for exact
     /// frame counts) or the path tracer.
+    #[command(allow_negative_numbers = true)]
     Render(app::RenderArgs),
     /// Print a scene's triangles, emitters, lights, materials, bounds and cameras; with
     /// --kernels, the SPIR-V size and compile time of each kernel the scene would use.
+    #[command(allow_negative_numbers = true)]
     Info(app::InfoArgs),
     /// Measure path-tracer throughput (M paths/s) on a scene after a warm-up; reports the median.
+    #[command(allow_negative_numbers = true)]
     Bench(app::BenchArgs),
     /// Path-trace a converged reference: mean EXR (--out NAME.exr) and variance EXR
     /// (NAME.variance.exr).
+    #[command(allow_negative_numbers = true)]
     Reference(app::ReferenceArgs),
     /// Add up reference shards (`reference --shard I/N`) into the mean EXR (--out NAME.exr) and
     /// variance EXR (NAME.variance.exr): the images one `reference` process of the same seed and
     /// spp writes, up to the order of floating-point sums.
+    #[command(allow_negative_numbers = true)]
     Merge(app::MergeArgs),
     /// Per-pass GPU times of ReSTIR PT frames: CSV, Chrome trace (Perfetto) and a stacked-bar SVG.
+    #[command(allow_negative_numbers = true)]
     Profile(app::ProfileArgs),
     /// Error against GPU time per frame for each method at equal time budgets, against a
     /// reference: results.csv, log-log charts (SVG, PNG) and an equal-time image strip.
+    #[command(allow_negative_numbers = true)]
     Compare(app::CompareArgs),
     /// Every scene and method over F frames, static and moving camera: non-finite pixels (must
     /// be 0), energy and relMSE per frame against references, flicker and failed-shift rate.
+    #[command(allow_negative_numbers = true)]
     Stability(app::StabilityArgs),
 }
 

@@ -100,8 +100,9 @@ fn cli_flags_the_method_ignores_are_named() {
     assert!(line.contains("non-finite pixels 0, weights 0"), "{line}");
 }
 
-/// Values that may be negative are taken as values, so that the command's own check explains
-/// what is wrong with them (clap took `-1,0,0` for a flag), and a negative EV works.
+/// Negative numbers are taken as values, so that the command's own check or clap's value parser
+/// explains what is wrong with them (clap took `-1,0,0` and `-1` for flags), and a negative EV
+/// works.
 #[test]
 fn cli_negative_values_are_values() {
     let out = temp_file("placeholder", b"").parent().unwrap().join("negative.exr");
@@ -112,6 +113,13 @@ fn cli_negative_values_are_values() {
         "{stderr}"
     );
     assert_clean_failure(&["render", "--radius", "-3"], &["--radius -3"]);
+    // An unsigned option given a negative number names the option and the value.
+    let (code, _, stderr) = restir_pt(&["render", "--frames", "-1"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("invalid value '-1' for '--frames") && !stderr.contains("unexpected argument"),
+        "{stderr}"
+    );
     assert_clean_failure(
         &["compare", "scenes/cornell.gltf", "--reference", "x.exr", "--budgets-ms", "-5"],
         &["--budgets-ms -5"],
