@@ -34,8 +34,9 @@ const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record:
 /// What one ReSTIR PT frame ([`Restir::frame`]) took, and its counters.
 #[derive(Debug, Clone)]
 pub struct FrameStats {
-    /// GPU milliseconds per pass, indexed like [`PASS_NAMES`](super::PASS_NAMES) (initial, temporal, spatial, shade;
-    /// about 0 for a pass the frame did not run); `None` where the device has no timestamp queries.
+    /// GPU milliseconds per pass, indexed like [`PASS_NAMES`](super::PASS_NAMES) (initial,
+    /// temporal, spatial, shade; about 0 for a pass the frame did not run); `None` where the
+    /// device has no timestamp queries.
     pub pass_ms: Option<PassTimes>,
     /// Wall-clock milliseconds of the frame, parameter upload and counter readback included.
     pub wall_ms: f64,
