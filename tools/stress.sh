@@ -18,23 +18,31 @@ for l in sys.stdin:
         print(m["executable"])')
 [ -x "$suite" ] || { echo "tools/stress.sh: no suite binary found" >&2; exit 1; }
 end=$(( $(date +%s) + 60 * minutes ))
-runs=0; crashed=0; failed=0
-while [ "$(date +%s)" -lt "$end" ]; do
-  runs=$((runs + 1))
-  # The ReSTIR tests take longer than a short run: both processes stop at the deadline, which
-  # `timeout` reports as 124 and is no failure; a signal of their own is a crash.
-  left=$(( end - $(date +%s) ))
-  RESTIR_PT_STRESS_SECONDS=120 timeout "$left" "$suite" --test-threads=3 stress_ >"$out/stress-$runs.log" 2>&1 &
-  stress=$!
-  timeout "$left" "$suite" --test-threads=2 restir >"$out/restir-$runs.log" 2>&1 &
-  restir=$!
-  for pid in $stress $restir; do
-    wait "$pid"; rc=$?
-    if [ "$rc" -eq 124 ]; then echo "run $runs: process $pid stopped at the deadline";
-    elif [ "$rc" -gt 128 ]; then crashed=$((crashed + 1)); echo "run $runs: process $pid died of signal $((rc - 128))";
-    elif [ "$rc" -ne 0 ]; then failed=$((failed + 1)); echo "run $runs: process $pid failed (exit $rc)"; fi
+: >"$out/tally"
+# Runs the suite with "$@" again and again until the deadline, each run's log in
+# $out/$name-N.log. A run stopped at the deadline (`timeout`'s 124) is no failure; a signal of
+# the process's own is a crash.
+repeat() {
+  local name=$1 n=0 left rc
+  shift
+  while [ "$(date +%s)" -lt "$end" ]; do
+    n=$((n + 1))
+    left=$(( end - $(date +%s) ))
+    timeout "$left" env RESTIR_PT_STRESS_SECONDS=120 "$suite" "$@" >"$out/$name-$n.log" 2>&1
+    rc=$?
+    if [ "$rc" -eq 124 ]; then echo "$name run $n: stopped at the deadline"
+    elif [ "$rc" -gt 128 ]; then echo crash >>"$out/tally"; echo "$name run $n: died of signal $((rc - 128))"
+    elif [ "$rc" -ne 0 ]; then echo fail >>"$out/tally"; echo "$name run $n: failed (exit $rc)"
+    else echo "$name run $n: passed (load $(cut -d' ' -f1-3 /proc/loadavg))"; fi
   done
-  echo "run $runs done ($(uptime | sed 's/.*load average: //'))"
-done
+}
+# The stress tests (many validated devices on threads, each rendering and dropping) again and
+# again beside the ReSTIR tests as threads of one process, the way the crash first appeared.
+repeat stress --test-threads=3 stress_ &
+repeat restir --test-threads=2 restir &
+wait
+runs=$(ls "$out" | grep -c '\.log$')
+crashed=$(grep -c crash "$out/tally")
+failed=$(grep -c fail "$out/tally")
 echo "tools/stress.sh: $runs runs in $minutes min: $crashed crashed, $failed failed (logs in $out)"
 [ "$crashed" -eq 0 ] && [ "$failed" -eq 0 ]
