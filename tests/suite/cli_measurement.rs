@@ -112,9 +112,14 @@ fn cli_compare_writes_results_charts_and_strip() {
         assert!(flip > 0.0 && flip < 1.0, "HDR-FLIP: {row:?}");
         assert!(pt_samples > 0.0 && pt_samples.is_finite(), "frame in path-tracer samples: {row:?}");
     }
-    // The path tracer's frame of n samples costs at least about n samples.
-    let pt_samples = |r: &Vec<&str>| r[13].parse::<f64>().unwrap();
-    assert!(pt_samples(&rows[1]) >= 0.7 * spp(&rows[1]) as f64, "{csv}");
+    // Every row's frame is measured in the one path-tracer sample cost calibrated in the run, so
+    // pt_samples / gpu_ms is the same on every row (up to the CSV's four decimals). How many
+    // samples a frame of n costs is a timing, which depends on the machine's load: it belongs
+    // to the README's results, not to a test.
+    let per_ms = |r: &Vec<&str>| r[13].parse::<f64>().unwrap() / r[3].parse::<f64>().unwrap();
+    for row in &rows[1..] {
+        assert!((per_ms(row) / per_ms(&rows[0]) - 1.0).abs() < 1e-3, "{csv}");
+    }
     // A larger budget buys the path tracer more samples per frame.
     assert!(rows[0][0] == "pt" && rows[1][0] == "pt" && spp(&rows[1]) > spp(&rows[0]), "{csv}");
     assert!(rows[2][2].starts_with("reservoirs="), "{csv}");
