@@ -245,16 +245,16 @@ pub(super) fn check_external_buffers(json: &Value, base: Option<&Path>, path: &P
             ));
         };
         let file = base.join(percent_decode(uri));
-        if !file.is_file() {
-            bail!(problem(
+        let held = match std::fs::metadata(&file) {
+            Ok(m) if m.is_file() => m.len(),
+            _ => bail!(problem(
                 path,
                 format!("buffer {i}: external file {uri:?} not found (looked for {})", file.display())
-            ));
-        }
+            )),
+        };
         // A truncated .bin is named here: the gltf crate's own message names neither the buffer's
         // file nor the glTF.
         let declared = buffer.get("byteLength").and_then(Value::as_u64).unwrap_or(0);
-        let held = std::fs::metadata(&file).map_or(0, |m| m.len());
         if held < declared {
             bail!(problem(
                 path,

@@ -1,5 +1,6 @@
 //! Bad input, limits and faults: never a panic, a hang, a device loss or a silently wrong image.
 
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -35,6 +36,31 @@ fn run_with_deadline(args: &[&str], deadline: Duration) -> (i32, String) {
     }
 }
 
+/// `render` of `path` with the path tracer at 16 x 16 and 1 spp into `out`, within 60 s: the
+/// exit code and stderr.
+fn render_one_spp(path: &Path, out: &Path) -> (i32, String) {
+    let args = [
+        "render",
+        path.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--method",
+        "pt",
+        "--spp",
+        "1",
+    ];
+    run_with_deadline(&[&args[..], &["--out", out.to_str().unwrap()]].concat(), Duration::from_secs(60))
+}
+
+/// The one `error:` line of `stderr`, of input `what`.
+fn the_error_line<'a>(what: &str, stderr: &'a str) -> &'a str {
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{what}: {stderr}");
+    errors[0]
+}
+
 /// A .bin shorter than its buffer's byteLength: one error line naming the glTF, the buffer's
 /// file and both sizes (the gltf crate's own message names neither file).
 #[test]
@@ -43,27 +69,12 @@ fn robustness_truncated_external_buffer_names_its_file() {
     assert!(gltf.contains("missing.bin"));
     let path = temp_file("short-bin.gltf", gltf.replace("missing.bin", "short.bin").as_bytes());
     std::fs::write(path.with_file_name("short.bin"), [0u8; 12]).unwrap();
-    let out = path.with_file_name("short.exr");
-    let args = [
-        "render",
-        path.to_str().unwrap(),
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--method",
-        "pt",
-        "--spp",
-        "1",
-    ];
-    let (code, stderr) = run_with_deadline(&[&args[..], &["--out", out.to_str().unwrap()]].concat(), Duration::from_secs(60));
+    let (code, stderr) = render_one_spp(&path, &path.with_file_name("short.exr"));
     assert_eq!(code, 1, "{stderr}");
-    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
-    assert_eq!(errors.len(), 1, "{stderr}");
+    let error = the_error_line("short-bin.gltf", &stderr);
     assert!(
-        errors[0].contains("short-bin.gltf") && errors[0].contains("\"short.bin\" holds 12 bytes") && errors[0].contains("byteLength"),
-        "{}",
-        errors[0]
+        error.contains("short-bin.gltf") && error.contains("\"short.bin\" holds 12 bytes") && error.contains("byteLength"),
+        "{error}"
     );
 }
 
@@ -91,35 +102,14 @@ fn robustness_bad_input_corpus_gives_clear_errors_or_warnings() {
             .unwrap_or_else(|| panic!("tests/data/bad/{file} has no line in expected.txt"));
         let (outcome, needle) = (row[1], row.get(2).copied().unwrap_or(""));
         let path = dir.join(file);
-        let (code, stderr) = run_with_deadline(
-            &[
-                "render",
-                path.to_str().unwrap(),
-                "--width",
-                "16",
-                "--height",
-                "16",
-                "--method",
-                "pt",
-                "--spp",
-                "1",
-                "--out",
-                out.to_str().unwrap(),
-            ],
-            Duration::from_secs(60),
-        );
+        let (code, stderr) = render_one_spp(&path, &out);
         assert!(!stderr.contains("panicked") && !stderr.contains("DEVICE_LOST"), "{file}: {stderr}");
         assert!(stderr.contains(needle), "{file}: stderr lacks {needle:?}: {stderr}");
         match outcome {
             "error" => {
                 assert_eq!(code, 1, "{file} must fail: {stderr}");
-                let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
-                assert_eq!(errors.len(), 1, "{file}: {stderr}");
-                assert!(
-                    errors[0].contains(file.as_str()) && errors[0].contains(needle),
-                    "{file}: {}",
-                    errors[0]
-                );
+                let error = the_error_line(file, &stderr);
+                assert!(error.contains(file.as_str()) && error.contains(needle), "{file}: {error}");
             }
             "warning" | "ok" => {
                 assert_eq!(code, 0, "{file} must render: {stderr}");
