@@ -262,7 +262,8 @@ pub struct PyDevice {
 impl PyDevice {
     /// Opens `device` (an index of `devices()` or a name substring; None: the first discrete,
     /// integrated, virtual then CPU device). `validation` turns the Vulkan validation layer on;
-    /// `check_validation()` then raises on anything it reported. Raises `DeviceError`.
+    /// `check_validation()` then raises on anything it reported (open and close validated
+    /// devices from one thread at a time: Debian 12's layer races otherwise). Raises `DeviceError`.
     #[new]
     #[pyo3(signature = (device = None, *, validation = false))]
     fn new(py: Python<'_>, device: Option<&Bound<'_, PyAny>>, validation: bool) -> PyResult<Self> {

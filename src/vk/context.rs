@@ -27,7 +27,10 @@ pub const DEFAULT_FENCE_TIMEOUT: std::time::Duration = std::time::Duration::from
 pub struct ContextOptions {
     /// Device name substring or index in enumeration order; `None` picks the best device.
     pub device: Option<String>,
-    /// Enables VK_LAYER_KHRONOS_validation and counts every message it reports.
+    /// Enables VK_LAYER_KHRONOS_validation and counts every message it reports. Debian 12's
+    /// layer (1.3.239) is not safe for validated devices made or dropped on one thread while
+    /// another thread uses one (a lock-free process-wide map; KhronosGroup/Vulkan-ValidationLayers
+    /// issue 4391): keep validated contexts to one thread at a time.
     pub validation: bool,
     /// Bytes past which a scene array is reached by buffer device address rather than bound (at most
     /// maxStorageBufferRange, the default). Tests lower it so that small scenes take the addressed path.

@@ -85,13 +85,16 @@ pub fn load(dir: &Path, key: &str) -> Option<Vec<u32>> {
 }
 
 /// Stores `spirv` under `key` in `dir`, creating the folder; written to a file of its own and
-/// renamed into place, so that processes compiling the same kernel at once never read half an
-/// entry. Failures are ignored: the cache only saves time.
+/// renamed into place, so that processes and threads compiling the same kernel at once never
+/// read half an entry (each writer has a file name of its own). Failures are ignored: the cache
+/// only saves time.
 pub fn store(dir: &Path, key: &str, spirv: &[u32]) {
+    static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     if std::fs::create_dir_all(dir).is_err() {
         return;
     }
-    let temp = dir.join(format!("{key}.{}.tmp", std::process::id()));
+    let write = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let temp = dir.join(format!("{key}.{}-{write}.tmp", std::process::id()));
     let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
     if std::fs::write(&temp, bytes).is_ok() && std::fs::rename(&temp, dir.join(format!("{key}.spv"))).is_err() {
         let _ = std::fs::remove_file(&temp);
