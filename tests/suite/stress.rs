@@ -10,7 +10,7 @@
 //! The devices on threads run without the validation layer: Debian 12's
 //! VK_LAYER_KHRONOS_validation 1.3.239 looks up each device's state in a process-wide map that
 //! device creation and destruction write without a lock (KhronosGroup/Vulkan-ValidationLayers
-//! issue 4391), and it crashed this test 2 times in 11 (a jump to 0x700000000 from inside the
+//! issue 4391), and it crashed this test 2 times in 19 (a jump to 0x700000000 from inside the
 //! layer, under `Kernel::new`, while another thread destroyed its device; docs/lab-notebook.md).
 //!
 //! `RESTIR_PT_STRESS_SECONDS` (default 40) and `RESTIR_PT_STRESS_THREADS` (default 4) set the
