@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Stress run for driver crashes under load: for MINUTES (default 30), again and again, the suite's
 # stress tests (many devices on threads, each rendering and dropping, then a validated one) beside
-# the ReSTIR tests in one process (the way the crash first appeared). Counts runs that died of a
+# the ReSTIR tests (the load under which the crash first appeared). Counts runs that died of a
 # signal or failed, and keeps their logs in OUT (default out/stress). Exit status 1 if any.
 # Usage: tools/stress.sh [MINUTES] [OUT]
 set -uo pipefail
@@ -36,7 +36,7 @@ repeat() {
     else echo "$name run $n: passed (load $(cut -d' ' -f1-3 /proc/loadavg))"; fi
   done
 }
-# The stress tests again and again beside the ReSTIR tests in one process, each on one test
+# The stress tests again and again beside the ReSTIR tests, each in one process on one test
 # thread: validated devices must not be made or dropped on one thread while another uses one, a
 # race in Debian's validation layer (docs/testing.md).
 repeat stress --test-threads=1 stress_ &
