@@ -48,8 +48,10 @@ pub fn info(args: InfoArgs) -> Result<()> {
             ..Default::default()
         };
         let scene_gpu = SceneGpu::upload(&ctx, &scene)?;
-        // One kernel at a time, so that each stage's process CPU time is that stage's alone.
+        // One kernel at a time and no twin device, so that each stage's process CPU time is
+        // that stage's alone.
         restir_pt::vk::set_compile_threads(0);
+        restir_pt::vk::set_twin_compile(false);
         let mut reports = vec![PathTracer::new(&scene_gpu, &settings)?.compile_report().clone()];
         reports.extend(Restir::new(&scene_gpu, &settings, &restir)?.compile_reports());
         drop(scene_gpu);

@@ -172,7 +172,12 @@ fn pass_times(scene: &Arc<SceneGpu>, settings: &RenderSettings, restir: &RestirS
     let spinner = compile_progress();
     let mut renderer = Restir::with_progress(scene, settings, restir, &|name| spinner.set_message(name.to_string()))?;
     spinner.finish_and_clear();
-    print_compile_summary(&renderer.compile_reports(), renderer.compile_ms(), renderer.compile_cpu_ms());
+    print_compile_summary(
+        &renderer.compile_reports(),
+        renderer.compile_ms(),
+        renderer.compile_cpu_ms(),
+        renderer.twin_warmed_kernels(),
+    );
     let mut times = vec![];
     for f in 0..args.frames {
         let stats = if args.camera_path {

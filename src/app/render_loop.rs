@@ -125,6 +125,7 @@ pub(super) fn render_path_traced(job: &Job) -> Result<RenderReport> {
         std::slice::from_ref(tracer.compile_report()),
         compile_ms,
         tracer.compile_report().total_cpu_ms(),
+        0,
     );
     let budget = match job.run {
         RunLength::GpuMs(ms) => Some(budget_bar(ms)),
@@ -185,7 +186,12 @@ pub(super) fn render_restir(job: &Job, restir: &RestirSettings) -> Result<Render
     spinner.finish_and_clear();
     let compile_reports = renderer.compile_reports();
     let compile_ms = renderer.compile_ms();
-    print_compile_summary(&compile_reports, compile_ms, renderer.compile_cpu_ms());
+    print_compile_summary(
+        &compile_reports,
+        compile_ms,
+        renderer.compile_cpu_ms(),
+        renderer.twin_warmed_kernels(),
+    );
     let spp = restir.candidates * restir.reservoirs;
     let budget = match job.run {
         RunLength::GpuMs(ms) => Some(budget_bar(ms)),

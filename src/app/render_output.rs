@@ -203,12 +203,18 @@ pub fn status_spinner() -> indicatif::ProgressBar {
 }
 
 /// The start-up line: how long compiling the kernels took, wall-clock (`wall_ms`) and in CPU
-/// time of the process (`cpu_ms`, which other processes do not inflate), and the GLSL stage's
-/// CPU time over all kernels (on worker threads, overlapping the driver's compiles).
-pub fn print_compile_summary(kernels: &[restir_pt::vk::KernelCompile], wall_ms: f64, cpu_ms: f64) {
+/// time of the process (`cpu_ms`, which other processes do not inflate), the GLSL stage's CPU
+/// time over all kernels (on worker threads, overlapping the driver's compiles), and how many
+/// kernels a twin device compiled into the driver's cache meanwhile (`twin_warmed`,
+/// `Restir::twin_warmed_kernels`).
+pub fn print_compile_summary(kernels: &[restir_pt::vk::KernelCompile], wall_ms: f64, cpu_ms: f64, twin_warmed: usize) {
     let glsl: f64 = kernels.iter().map(|k| k.glsl_cpu_ms).sum();
+    let twin = match twin_warmed {
+        0 => String::new(),
+        n => format!("; {n} of them first on a twin device"),
+    };
     eprintln!(
-        "start-up: {} kernel(s) compiled in {wall_ms:.0} ms ({cpu_ms:.0} ms of CPU time, {glsl:.0} of it GLSL to SPIR-V)",
+        "start-up: {} kernel(s) compiled in {wall_ms:.0} ms ({cpu_ms:.0} ms of CPU time, {glsl:.0} of it GLSL to SPIR-V{twin})",
         kernels.len()
     );
 }

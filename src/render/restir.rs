@@ -18,13 +18,40 @@ use crate::gpu_types::{FrameParams, RestirStats, ReuseParams};
 use crate::scene::Camera;
 use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
-use crate::vk::{compile_kernels_in_parallel, process_cpu_ms, Binding, Context, Kernel, KernelCompile, PassTimer};
+use crate::vk::{
+    compile_kernels_in_parallel, process_cpu_ms, twin_compile_pays, warm_up_on_twin, Binding, CompiledKernel, Context, Kernel,
+    KernelCompile, PassTimer, TwinKernel,
+};
 
 mod buffers;
 mod params;
 mod record;
 
 const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
+
+/// The push block of a warm-up dispatch (the kernels' one push word, the pass's seed).
+const WARM_UP_PUSH: [u8; 4] = [0; 4];
+
+/// Kernels `compiled` split in two sets of about equal SPIR-V size (llvmpipe's compile time
+/// grows with it), the largest kernel in the first: indices into `compiled`, each set in
+/// ascending order.
+fn halves_by_size(compiled: &[CompiledKernel]) -> (Vec<usize>, Vec<usize>) {
+    let mut order: Vec<usize> = (0..compiled.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(compiled[i].spirv.len()));
+    let (mut halves, mut sizes) = ((Vec::new(), Vec::new()), (0, 0));
+    for i in order {
+        if sizes.0 <= sizes.1 {
+            halves.0.push(i);
+            sizes.0 += compiled[i].spirv.len();
+        } else {
+            halves.1.push(i);
+            sizes.1 += compiled[i].spirv.len();
+        }
+    }
+    halves.0.sort_unstable();
+    halves.1.sort_unstable();
+    halves
+}
 
 /// Shared memory of one workgroup of the ReSTIR kernels: the path being built by each of its
 /// LOCAL_SIZE² invocations (glsl/shift_path.glsl, `path_vertices`, `path_lobes`, `path_weights`),
@@ -87,6 +114,8 @@ pub struct Restir {
     /// Wall-clock and process CPU milliseconds spent building kernels (`compile_ms`).
     compile_ms: f64,
     compile_cpu_ms: f64,
+    /// Kernels a twin device compiled into the driver's cache first (`build`).
+    twin_warmed: usize,
     buffers: RestirBuffers,
     /// The image and the per-frame counters come back through it.
     readback: AccumReadback,
@@ -149,6 +178,7 @@ impl Restir {
             kernels: PassKernel::ALL.iter().map(|_| None).collect(),
             compile_ms: 0.0,
             compile_cpu_ms: 0.0,
+            twin_warmed: 0,
             buffers,
             readback: AccumReadback::new(ctx, settings.width, settings.height, stats_bytes)?,
             scene_gpu: scene.clone(),
@@ -168,7 +198,10 @@ impl Restir {
     /// (`compile_kernels_in_parallel`), each pipeline created, bound and dispatched once over
     /// an image of zero pixels (which writes nothing) on this thread as soon as its SPIR-V is
     /// ready. llvmpipe compiles a kernel at its first dispatch, and that compile belongs to
-    /// start-up, not to a frame's GPU time.
+    /// start-up, not to a frame's GPU time. Where a twin device pays (`twin_compile_pays`),
+    /// about half of the kernels, by SPIR-V size, are first compiled on a twin device on
+    /// another thread while this thread builds the other half, and then found in the driver's
+    /// disk cache (src/vk/twin_compile.rs).
     fn build(&mut self, wanted: &[PassKernel], progress: &dyn Fn(&str)) -> Result<()> {
         let (start, cpu) = (Instant::now(), process_cpu_ms());
         let mut todo: Vec<PassKernel> = Vec::new();
@@ -199,18 +232,53 @@ impl Restir {
                 (file, defines.iter().chain(extra).copied().collect())
             })
             .collect();
-        compile_kernels_in_parallel(&jobs, |i, compiled| {
-            let kernel = todo[i];
-            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, &compiled, layout.clone(), 4)?;
-            if kernel == PassKernel::TemporalUnmoved {
+        let mut built = 0;
+        let mut build_one = |this: &mut Self, i: usize, compiled: &CompiledKernel| -> Result<()> {
+            built += 1;
+            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, compiled, layout.clone(), 4)?;
+            if todo[i] == PassKernel::TemporalUnmoved {
                 k.set_variant("(unmoved camera)");
             }
-            progress(&format!("{} ({}/{})", k.compile_report().name, i + 1, todo.len()));
-            k.bind(&self.buffers.binding_table(&scene_gpu))?;
-            k.warm_up(&0u32.to_ne_bytes()).with_context(|| format!("compiling {}", k.name))?;
-            self.kernels[kernel as usize] = Some(k);
+            progress(&format!("{} ({built}/{})", k.compile_report().name, todo.len()));
+            k.bind(&this.buffers.binding_table(&scene_gpu))?;
+            k.warm_up(&WARM_UP_PUSH).with_context(|| format!("compiling {}", k.name))?;
+            this.kernels[todo[i] as usize] = Some(k);
             Ok(())
-        })?;
+        };
+        if todo.len() < 2 || !twin_compile_pays(&self.ctx) {
+            compile_kernels_in_parallel(&jobs, |i, compiled| build_one(self, i, &compiled))?;
+        } else {
+            let mut compiled = Vec::new();
+            compile_kernels_in_parallel(&jobs, |_, c| {
+                compiled.push(c);
+                Ok(())
+            })?;
+            let (mine, theirs) = halves_by_size(&compiled);
+            let full_layout = scene_gpu.layout(layout.clone());
+            let twin_kernels: Vec<TwinKernel> = theirs
+                .iter()
+                .map(|&i| TwinKernel {
+                    name: jobs[i].0,
+                    compiled: &compiled[i],
+                    layout: &full_layout,
+                    push: &WARM_UP_PUSH,
+                })
+                .collect();
+            let ctx = self.ctx.clone();
+            let mut this_twin_warmed = 0;
+            std::thread::scope(|scope| -> Result<()> {
+                let twin = scope.spawn(move || warm_up_on_twin(&ctx, &twin_kernels));
+                for &i in &mine {
+                    build_one(self, i, &compiled[i])?;
+                }
+                // A twin that failed only leaves its kernels to be compiled here.
+                if matches!(twin.join(), Ok(Ok(()))) {
+                    this_twin_warmed += theirs.len();
+                }
+                theirs.iter().try_for_each(|&i| build_one(self, i, &compiled[i]))
+            })?;
+            self.twin_warmed += this_twin_warmed;
+        }
         self.compile_ms += start.elapsed().as_secs_f64() * 1e3;
         self.compile_cpu_ms += process_cpu_ms() - cpu;
         Ok(())
@@ -230,6 +298,13 @@ impl Restir {
     /// later. Below the sum of the reports' stages where GLSL compiled on other threads.
     pub fn compile_ms(&self) -> f64 {
         self.compile_ms
+    }
+
+    /// How many of the kernels built so far a twin device compiled first, into the driver's
+    /// disk cache, while this device compiled the others (src/vk/twin_compile.rs); 0 where no
+    /// twin paid or it failed.
+    pub fn twin_warmed_kernels(&self) -> usize {
+        self.twin_warmed
     }
 
     /// CPU milliseconds of the whole process while it built kernels (every thread: GLSL

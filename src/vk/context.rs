@@ -186,6 +186,11 @@ impl Context {
         self.validation_log.messages()
     }
 
+    /// Whether the validation layer is on for this device (`ContextOptions::validation`).
+    pub fn validated(&self) -> bool {
+        self.debug.is_some()
+    }
+
     /// The log itself, to read after the context is dropped (leaked objects are reported then).
     pub fn validation_log(&self) -> Arc<ValidationLog> {
         self.validation_log.clone()

@@ -9,6 +9,7 @@ mod reflect;
 mod shader;
 mod spirv_cache;
 mod timer;
+mod twin_compile;
 
 pub use buffer::{Buffer, BufferUsage};
 pub use context::{Context, ContextOptions, DeviceInfo, ValidationLog, DEFAULT_FENCE_TIMEOUT};
@@ -21,3 +22,4 @@ pub use shader::{
 };
 pub use spirv_cache::{cache_dir as spirv_cache_dir, SPIRV_CACHE_ENV};
 pub use timer::PassTimer;
+pub use twin_compile::{set_twin_compile, twin_compile_pays, warm_up_on_twin, TwinKernel, TWIN_COMPILE_ENV};

@@ -4,9 +4,11 @@
 //! Cornell box built into the binary, from any folder.
 
 use std::process::Command;
+use std::sync::Arc;
 
 use restir_pt::render::{PassKernel, Restir, RestirSettings, SceneGpu};
 use restir_pt::scene::load_scene;
+use restir_pt::vk::{set_twin_compile, twin_compile_pays, Context, ContextOptions, TWIN_COMPILE_ENV};
 
 use crate::common::{assert_clean, gpu, repo_path, temp_file};
 use crate::restir_unbiased::settings;
@@ -43,39 +45,74 @@ fn restir_kernels_built_on_demand_render_the_same_frames_bit_for_bit() {
         ..settings(1)
     };
     let restir = RestirSettings::default();
-    let frames = |renderer: &mut Restir| -> Vec<Vec<u32>> {
-        let poses = [(0, true), (0, true), (0, true), (1, false), (2, false)];
-        poses
-            .iter()
-            .map(|&(camera, accumulate)| {
-                renderer.frame(camera, accumulate).unwrap();
-                renderer
-                    .image()
-                    .unwrap()
-                    .mean
-                    .iter()
-                    .flat_map(|v| v.to_array().map(f32::to_bits))
-                    .collect()
-            })
-            .collect()
-    };
     let mut every = Restir::new(&scene, &small, &restir).unwrap();
-    let expected = frames(&mut every);
+    let expected = frame_bits(&mut every);
     let before = ctx.pipelines_created();
     let mut lazy = Restir::with_kernels(&scene, &small, &restir, &[PassKernel::Initial, PassKernel::Shade], &|_| {}).unwrap();
     assert_eq!(ctx.pipelines_created() - before, 2, "start-up built other kernels");
     assert_eq!(lazy.compile_reports().len(), 2);
-    let got = frames(&mut lazy);
+    let got = frame_bits(&mut lazy);
     assert_eq!(ctx.pipelines_created() - before, 5, "the frames built kernels twice or not at all");
-    for (frame, (g, e)) in got.iter().zip(&expected).enumerate() {
-        let differing = g.iter().zip(e).filter(|(a, b)| a != b).count();
-        assert_eq!(differing, 0, "frame {frame}: {differing} of {} values differ", g.len());
-    }
+    assert_same_frames(&got, &expected);
     let names: Vec<String> = lazy.compile_reports().iter().map(|k| k.name.clone()).collect();
     assert!(names.iter().any(|n| n.contains("unmoved")), "{names:?}");
     assert!(lazy.compile_ms() > 0.0 && lazy.compile_cpu_ms() > 0.0);
     drop((every, lazy, scene));
     assert_clean(&ctx);
+}
+
+/// The average's bits after each of five frames: three of a still camera (the unmoved
+/// temporal pass), then two moving (the shifting temporal pass).
+fn frame_bits(renderer: &mut Restir) -> Vec<Vec<u32>> {
+    let poses = [(0, true), (0, true), (0, true), (1, false), (2, false)];
+    poses
+        .iter()
+        .map(|&(camera, accumulate)| {
+            renderer.frame(camera, accumulate).unwrap();
+            let image = renderer.image().unwrap();
+            image.mean.iter().flat_map(|v| v.to_array().map(f32::to_bits)).collect()
+        })
+        .collect()
+}
+
+fn assert_same_frames(got: &[Vec<u32>], expected: &[Vec<u32>]) {
+    for (frame, (g, e)) in got.iter().zip(expected).enumerate() {
+        let differing = g.iter().zip(e).filter(|(a, b)| a != b).count();
+        assert_eq!(differing, 0, "frame {frame}: {differing} of {} values differ", g.len());
+    }
+}
+
+// Kernels warmed up on a twin device (src/vk/twin_compile.rs) while the renderer's device
+// compiles the others: the renderer still creates and dispatches every kernel itself, and its
+// frames equal, bit for bit, those of a renderer built without a twin. The twin runs only on
+// unvalidated CPU devices with a second core (the validation layer of Debian 12 races between
+// devices on two threads).
+#[test]
+fn restir_kernels_warmed_up_on_a_twin_device_render_the_same_frames_bit_for_bit() {
+    assert!(!twin_compile_pays(&gpu()), "a validated device must not get a twin");
+    let ctx = Arc::new(Context::new(&ContextOptions::default()).unwrap());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cpu_device = ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU;
+    let mesa_cache_off = std::env::var("MESA_SHADER_CACHE_DISABLE").is_ok_and(|v| v == "true" || v == "1");
+    let expected_twin = cpu_device && cores >= 2 && !mesa_cache_off && std::env::var(TWIN_COMPILE_ENV).map_or(true, |v| v != "0");
+    assert_eq!(twin_compile_pays(&ctx), expected_twin, "{} with {cores} cores", ctx.info.name);
+    let scene = SceneGpu::upload(&ctx, &load_scene(&repo_path("scenes/cornell-glossy.gltf")).unwrap()).unwrap();
+    let small = restir_pt::render::RenderSettings {
+        width: 20,
+        height: 12,
+        ..settings(3)
+    };
+    let restir = RestirSettings::default();
+    set_twin_compile(false);
+    let alone = Restir::new(&scene, &small, &restir);
+    set_twin_compile(true);
+    let expected = frame_bits(&mut alone.unwrap());
+    let mut twinned = Restir::new(&scene, &small, &restir).unwrap();
+    assert_eq!(twinned.compile_reports().len(), PassKernel::ALL.len());
+    let warmed = twinned.twin_warmed_kernels();
+    let expected_warmed = if expected_twin { 1..PassKernel::ALL.len() } else { 0..1 };
+    assert!(expected_warmed.contains(&warmed), "{warmed} kernels warmed on the twin");
+    assert_same_frames(&frame_bits(&mut twinned), &expected);
 }
 
 /// Runs the binary in the folder `dir`.

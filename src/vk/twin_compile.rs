@@ -1,0 +1,104 @@
+//! Compiling kernels on a second device so that the driver's disk cache serves the first.
+//!
+//! llvmpipe compiles a kernel with LLVM at its first dispatch, on the queue's one thread, and
+//! stores the machine code in Mesa's disk cache under a key of the shader's NIR and its variant
+//! key (Mesa's `lp_cs_get_ir_cache_key`). A renderer that warms up N kernels one after another
+//! therefore keeps one core busy for N compiles. A second device of the same driver, made by
+//! another instance on another thread, compiles the same SPIR-V into the same cache entries:
+//! while it warms up half of the kernels, the first device warms up the other half, and then
+//! finds the twin's half in the cache. The twin only fills a cache: every kernel is still
+//! created and dispatched on the renderer's own device, so images cannot differ.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use anyhow::Result;
+use ash::vk;
+
+use super::shader::CompiledKernel;
+use super::BindingSlot;
+use super::{Binding, Buffer, BufferUsage, Context, ContextOptions, Kernel};
+
+/// Whether `twin_compile_pays` may say yes (see `set_twin_compile`).
+static TWIN_COMPILE: AtomicBool = AtomicBool::new(true);
+
+/// The environment variable that switches twin compiles off when set to `0`.
+pub const TWIN_COMPILE_ENV: &str = "RESTIR_PT_TWIN_COMPILE";
+
+/// Turns compiling on a twin device on or off for the whole process (on by default unless
+/// [`TWIN_COMPILE_ENV`] is `0`), e.g. to measure a start-up without it.
+pub fn set_twin_compile(on: bool) {
+    TWIN_COMPILE.store(on, Ordering::Relaxed);
+}
+
+/// One kernel for [`warm_up_on_twin`]: its GLSL file name, SPIR-V, bindings of every set and
+/// the push-constant bytes its warm-up dispatch passes.
+pub struct TwinKernel<'a> {
+    /// The GLSL file name, for errors.
+    pub name: &'a str,
+    /// The SPIR-V exactly as the renderer's device gets it (another module is another cache key).
+    pub compiled: &'a CompiledKernel,
+    /// The kernel's bindings, as the renderer's device gets them.
+    pub layout: &'a [BindingSlot],
+    /// The push-constant block of the warm-up dispatch.
+    pub push: &'a [u8],
+}
+
+/// Whether warming kernels up on a twin of `ctx`'s device can shorten a start-up: the device
+/// compiles at first dispatch into a disk cache (a CPU device: lavapipe), Mesa's disk cache is
+/// not switched off, the machine has a second core, and no validation layer is in the process
+/// (Debian 12's layer races between devices made on two threads; see
+/// [`ContextOptions::validation`]).
+pub fn twin_compile_pays(ctx: &Context) -> bool {
+    let env_on = |name: &str| std::env::var(name).is_ok_and(|v| matches!(v.to_lowercase().as_str(), "1" | "true" | "yes"));
+    let layers_from_env = ["VK_INSTANCE_LAYERS", "VK_LOADER_LAYERS_ENABLE"]
+        .iter()
+        .any(|name| std::env::var(name).is_ok_and(|v| !v.is_empty()));
+    TWIN_COMPILE.load(Ordering::Relaxed)
+        && std::env::var(TWIN_COMPILE_ENV).map_or(true, |v| v != "0")
+        && ctx.info.device_type == vk::PhysicalDeviceType::CPU
+        && !ctx.validated()
+        && !layers_from_env
+        && !env_on("MESA_SHADER_CACHE_DISABLE")
+        && !env_on("MESA_GLSL_CACHE_DISABLE")
+        && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+}
+
+/// Makes a twin of `ctx`'s device (same driver and device name, no validation), creates each
+/// of `kernels` there with zero-filled buffers at every binding and dispatches it once, which
+/// makes a compile-at-dispatch driver compile it into its disk cache. The caller's push block
+/// and the zeroed parameters must make that dispatch write nothing of consequence: the buffers
+/// are dropped with the twin. Returns when the twin is destroyed, which flushes the cache.
+///
+/// # Errors
+/// A failed device creation, allocation, pipeline or dispatch on the twin. The renderer's own
+/// device is not touched, so a caller may ignore the error and compile as if no twin ran.
+pub fn warm_up_on_twin(ctx: &Context, kernels: &[TwinKernel]) -> Result<()> {
+    let twin = Arc::new(Context::new(&ContextOptions {
+        device: Some(ctx.info.name.clone()),
+        validation: false,
+        ..Default::default()
+    })?);
+    for k in kernels {
+        // A binding's buffer is as large as a block may be bound (uniform) or 64 KiB, so that
+        // a dispatch reading a parameter block reads zeros.
+        let buffers = k
+            .layout
+            .iter()
+            .map(|slot| {
+                let bytes = match slot.kind {
+                    Binding::Uniform => twin.info.max_uniform_buffer_range.min(1 << 16),
+                    Binding::Storage => 1 << 16,
+                };
+                let buffer = Buffer::new(&twin, slot.block, bytes, BufferUsage::Storage)?;
+                buffer.fill(0)?;
+                Ok(buffer)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut kernel = Kernel::with_spirv(&twin, k.name, k.compiled, k.layout, k.push.len() as u32)?;
+        let bound: Vec<_> = k.layout.iter().zip(&buffers).map(|(slot, b)| slot.to(b)).collect();
+        kernel.bind(&bound)?;
+        kernel.warm_up(k.push)?;
+    }
+    Ok(())
+}
