@@ -18,8 +18,6 @@
 #include "trace_pair.glsl"
 
 const float RAY_TMAX = 1e30;
-const float RR_MAX_SURVIVAL = 0.95;
-const uint RR_START_DEPTH = 3u;
 
 
 // The ray that tells whether the light sample is hidden from the shading point x (geometric

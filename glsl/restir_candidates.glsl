@@ -66,23 +66,36 @@ void record_chosen(inout Resampler s, Path p, TracedCandidate c, ShiftParams par
 }
 
 // Streams every light-ending prefix of at most `max_length` vertices of the path from y1 with
-// `seed` into `s`.
+// `seed` into `s`. With `russian_roulette` the path goes on from x_i (i >= RR_START_DEPTH) with
+// probability q = min(throughput / (product of the earlier q), RR_MAX_SURVIVAL), as the path
+// tracer's. Only the initial sampling uses it (Lin, Kettunen and Wyman 2026, "ReSTIR PT
+// Enhanced"): a later candidate's source pdf carries the product of the q, so its resampling
+// weight is divided by that product, while its contribution, the target function's argument
+// that the shifts and MIS weights evaluate, stays the path's own. The roulette draws
+// STREAM_RESAMPLE's z at x_i, which nothing else uses.
 void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed, uint max_length, ShiftParams params,
-                            float scale) {
+                            float scale, bool russian_roulette) {
     Path p;
     path_begin(camera, y1, seed, false, 0u, p);
     vec3 prefix = vec3(1.0);
     vec3 prev_pos = camera;
     TracedCandidate chosen;
     bool chose = false;
+    // 1 / the product of the survival probabilities so far.
+    float roulette = 1.0;
     for (uint i = 1u; i < max_length; ++i) {
         loop_tick();
         Vertex x = path_vertex(i - 1u);
         if (vertex_is_escaped(x)) break;
+        vec4 u = rng_uniform4(seed, i, STREAM_RESAMPLE);
+        if (russian_roulette && i >= RR_START_DEPTH) {
+            float survive = min(max_component(prefix) * roulette, RR_MAX_SURVIVAL);
+            if (u.z >= survive) break;
+            roulette /= survive;
+        }
         vec3 wo = normalize(prev_pos - x.pos);
         vec3 ns;
         Material m = vertex_shading(x, ns);
-        vec4 u = rng_uniform4(seed, i, STREAM_RESAMPLE);
 
         // NEE's techniques at x: the drawn light (t = 0), then every directional light (t = k + 1),
         // each a candidate of its own, in one loop so that the kernel holds one visibility test.
@@ -101,7 +114,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
             float end_weight = vertex_is_punctual(light) ? 1.0 : balance_heuristic(ls.pdf, bsdf_pdf);
             vec3 contribution = prefix * weight * end_emission(x, light) * end_weight;
             float u_offer = t == 0u ? u.x : rng_uniform4(seed, i, STREAM_DIRECTIONAL + t - 1u).x;
-            if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u_offer)) {
+            if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale * roulette, u_offer)) {
                 chosen = TracedCandidate(i + 1u, true, t, light, weight, end_weight, contribution);
                 chose = true;
             }
@@ -119,7 +132,7 @@ void stream_path_candidates(inout Resampler s, vec3 camera, Vertex y1, uint seed
         if (max_component(emitted) > 0.0) {
             float end_weight = end_mis_weight(x, prev_pos, next, false, (b.lobe & LOBE_DELTA) != 0u);
             vec3 contribution = prefix * emitted * end_weight;
-            if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale, u.y)) {
+            if (max_component(contribution) > 0.0 && offer_candidate(s, contribution, scale * roulette, u.y)) {
                 chosen = TracedCandidate(i + 1u, false, 0u, next, vec3(0.0), end_weight, contribution);
                 chose = true;
             }

@@ -68,7 +68,7 @@ void main() {
             if (c == 0u) emission = pixel_emission(p, seed, camera, dir, hit);
             if (hit.triangle == NO_HIT) continue;
             Vertex y1 = hit_vertex(hit);
-            stream_path_candidates(s, camera, y1, seed, max_length, params, scale);
+            stream_path_candidates(s, camera, y1, seed, max_length, params, scale, (flags & FLAG_RUSSIAN_ROULETTE) != 0u);
         }
         s.confidence = float(candidates);
         // Under an unmoved camera every frame estimates the same emission, so the estimate is

@@ -192,6 +192,13 @@ pub const MAX_NEIGHBOURS: u32 = 8;
 pub const MAX_INPUTS: u32 = MAX_NEIGHBOURS + 1;
 /// Width and height of a 2D workgroup of the image kernels (pathtrace.comp, restir_*.comp).
 pub const IMAGE_LOCAL_SIZE: u32 = 8;
+/// Russian roulette (the path tracer's and ReSTIR PT's initial candidates) starts at path
+/// vertex x_3 (x_1 the primary hit): the first two bounces always continue.
+pub const RR_START_DEPTH: u32 = 3;
+/// Russian roulette's survival probability is the path throughput's largest channel, at most
+/// this, so that a path of throughput 1 still ends in time (pbrt-v4 uses 1 without a cap; the
+/// cap bounds the expected length in closed scenes of albedo near 1).
+pub const RR_MAX_SURVIVAL: f32 = 0.95;
 /// Profile counters of glsl/counters.glsl, in its order (COUNTER_TRAVERSALS ...
 /// COUNTER_STEP_ITERATIONS), each a 64-bit sum.
 pub const COUNTER_COUNT: usize = 7;
@@ -251,6 +258,7 @@ fn build_header() -> String {
         ("MAX_INPUTS", MAX_INPUTS),
         ("IMAGE_LOCAL_SIZE", IMAGE_LOCAL_SIZE),
         ("COUNTER_COUNT", COUNTER_COUNT as u32),
+        ("RR_START_DEPTH", RR_START_DEPTH),
         ("MAX_PATH_LENGTH", crate::shading::path_record::MAX_PATH_LENGTH as u32),
         ("PUNCTUAL_ROWS", crate::gpu_types::PUNCTUAL_ROWS as u32),
         ("LIGHT_NODE_ROWS", crate::gpu_types::LIGHT_NODE_ROWS as u32),
@@ -262,6 +270,7 @@ fn build_header() -> String {
     for (name, value) in limits {
         writeln!(h, "#define {name} {value}u").expect("string write");
     }
+    writeln!(h, "#define RR_MAX_SURVIVAL {RR_MAX_SURVIVAL:?}").expect("string write");
     h.push_str("\n#endif\n");
     h
 }

@@ -1,7 +1,7 @@
 #version 460
 // Oracle kernel: the initial candidates of one traced path per item (stream_path_candidates of
 // restir_candidates.glsl) streamed into a fresh Resampler, from primary hits and seeds the host
-// chose. Twin: stream_path_candidates in src/shading/candidates.rs.
+// chose, with Russian roulette where the frame parameters' flags ask for it. Twin: stream_path_candidates in src/shading/candidates.rs.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
@@ -33,7 +33,9 @@ void main() {
     vec4 camera = items[2u * i + 1u];
     Vertex y1 = vertex_on_surface(floatBitsToUint(hit.w), hit.xyz);
     Resampler s = resampler_begin();
-    stream_path_candidates(s, camera.xyz, y1, floatBitsToUint(camera.w), params.x, shift_params, uintBitsToFloat(params.w));
+    bool russian_roulette = (flags & FLAG_RUSSIAN_ROULETTE) != 0u;
+    stream_path_candidates(s, camera.xyz, y1, floatBitsToUint(camera.w), params.x, shift_params, uintBitsToFloat(params.w),
+                           russian_roulette);
     Reservoir res = resampler_finish(s);
     PathRecord r = res.record;
     uint o = OUT_STRIDE * i;

@@ -103,6 +103,7 @@ def render(
     arguments. With ``return_stats`` returns ``(image, stats)``, one dict per frame. Flags the
     method ignores are warned about (``UserWarning``), as the CLI does.
     """
+    rr = True if russian_roulette is None else russian_roulette
     if method not in ("pt", "restir"):
         raise SettingsError(f"method {method!r}: expected 'pt' or 'restir'")
     if frames < 1:
@@ -111,8 +112,6 @@ def render(
     if method == "restir":
         if spp is not None:
             warnings.warn("--spp is ignored by ReSTIR PT, which renders --frames frames of --candidates paths per pixel (--method pt uses it)", stacklevel=2)
-        if russian_roulette:
-            warnings.warn("--russian-roulette on is ignored by ReSTIR PT, which traces every path to --max-depth (--method pt uses it)", stacklevel=2)
     else:
         changed = [_flag(k, v) for k, v in settings.items() if v != RESTIR_OPTIONS[k]]
         if changed:
@@ -132,7 +131,6 @@ def render(
     stats: List[Dict[str, Any]] = []
     if method == "pt":
         per_frame = 64 if spp is None else spp
-        rr = True if russian_roulette is None else russian_roulette
         tracer = PathTracer(uploaded, width=width, height=height, spp=per_frame, max_depth=max_depth, seed=seed, russian_roulette=rr, camera=camera)
         for f in range(frames):
             if f > 0 and static_camera:
@@ -142,7 +140,7 @@ def render(
             stats.append(tracer.render())
         image = tracer.image()
     else:
-        renderer = Restir(uploaded, width=width, height=height, max_depth=max_depth, seed=seed, camera=camera, **settings)
+        renderer = Restir(uploaded, width=width, height=height, max_depth=max_depth, seed=seed, camera=camera, russian_roulette=rr, **settings)
         stats = renderer.frames(frames, static_camera=static_camera)
         image = renderer.image()
     return (image, stats) if return_stats else image

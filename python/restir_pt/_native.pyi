@@ -109,7 +109,7 @@ class Restir:
 
     def __init__(
         self, scene: UploadedScene, *, width: Optional[int] = None, height: Optional[int] = None, max_depth: int = 7,
-        seed: int = 0, camera: int = 0, shift: str = "hybrid", mis: str = "gbh", temporal: bool = True,
+        seed: int = 0, camera: int = 0, russian_roulette: bool = True, shift: str = "hybrid", mis: str = "gbh", temporal: bool = True,
         history: str = "spatial", spatial: int = 1, radius: float = 5.0, rounds: int = 1, m_cap: float = 20.0,
         candidates: int = 1, reservoirs: int = 1, emission_rays: int = 4, normal_threshold: float = 0.9,
         depth_threshold: float = 0.1,

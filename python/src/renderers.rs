@@ -317,13 +317,13 @@ pub struct PyRestir {
 impl PyRestir {
     /// A ReSTIR PT renderer of `scene` (an `UploadedScene`), every kernel compiled. Settings as
     /// `restir-pt render --method restir` (names with underscores): width, height, max_depth
-    /// (at most 7), seed, camera, shift (reconnection|replay|hybrid), mis (gbh|pairwise),
+    /// (at most 7), seed, camera, russian_roulette (in the initial candidates), shift (reconnection|replay|hybrid), mis (gbh|pairwise),
     /// temporal, history (temporal|spatial), spatial, radius, rounds, m_cap, candidates,
     /// reservoirs, emission_rays; normal_threshold and depth_threshold (library only). Raises
     /// `SettingsError` with the CLI's message.
     #[new]
     #[pyo3(signature = (scene, *, width = None, height = None, max_depth = 7, seed = 0, camera = 0,
-        shift = "hybrid", mis = "gbh", temporal = true, history = "spatial", spatial = 1, radius = 5.0,
+        russian_roulette = true, shift = "hybrid", mis = "gbh", temporal = true, history = "spatial", spatial = 1, radius = 5.0,
         rounds = 1, m_cap = 20.0, candidates = 1, reservoirs = 1, emission_rays = 4,
         normal_threshold = 0.9, depth_threshold = 0.1))]
     #[allow(clippy::too_many_arguments)]
@@ -335,6 +335,7 @@ impl PyRestir {
         max_depth: u32,
         seed: u32,
         camera: usize,
+        russian_roulette: bool,
         shift: &str,
         mis: &str,
         temporal: bool,
@@ -356,7 +357,7 @@ impl PyRestir {
             RenderSettings::DEFAULT_SPP,
             max_depth,
             seed,
-            true,
+            russian_roulette,
             camera,
         )?;
         let restir = RestirSettings {

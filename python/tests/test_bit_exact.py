@@ -17,6 +17,8 @@ CASES = [
      dict(method="pt", spp=64, width=96, height=64, seed=2)),
     (["--width", "32", "--height", "32", "--frames", "1", "--seed", "3"],
      dict(method="restir", width=32, height=32, seed=3)),
+    (["--width", "32", "--height", "32", "--frames", "2", "--seed", "4", "--russian-roulette", "off"],
+     dict(method="restir", width=32, height=32, frames=2, seed=4, russian_roulette=False)),
     (["--width", "32", "--height", "32", "--frames", "4", "--seed", "5", "--shift", "reconnection", "--mis", "pairwise", "--reservoirs", "2", "--spatial", "2"],
      dict(method="restir", width=32, height=32, frames=4, seed=5, shift="reconnection", mis="pairwise", reservoirs=2, spatial=2)),
     (["--width", "32", "--height", "32", "--frames", "3", "--static-camera", "--camera", "2", "--temporal", "off"],
@@ -24,7 +26,7 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("cli_args,kwargs", CASES, ids=["pt", "pt-static", "pt-chunked", "restir", "restir-moving", "restir-static"])
+@pytest.mark.parametrize("cli_args,kwargs", CASES, ids=["pt", "pt-static", "pt-chunked", "restir", "restir-no-roulette", "restir-moving", "restir-static"])
 def test_array_equals_cli_exr_bit_for_bit(tmp_path, device, cli_args, kwargs):
     out = tmp_path / "cli.exr"
     run_cli("render", CORNELL, *cli_args, "--out", out)

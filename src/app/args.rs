@@ -217,6 +217,10 @@ pub struct PathArgs {
     /// Seed of the random numbers; runs of the same seed and settings are identical.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Russian roulette from the path's third vertex on (survival = its throughput, at most
+    /// 0.95): the path tracer's paths and ReSTIR PT's initial candidates, never its shifts.
+    #[arg(long, value_enum, default_value = "on")]
+    pub russian_roulette: Toggle,
 }
 
 /// Image size with fixed defaults (`render` has its own: a missing side follows the camera).

@@ -318,7 +318,7 @@ fn setup(args: &CompareArgs) -> Result<Setup> {
         max_depth: args.path.max_depth,
         seed: args.path.seed,
         camera: args.path.camera,
-        ..Default::default()
+        russian_roulette: args.path.russian_roulette.on(),
     };
     settings.validate(&SceneInfo::of(&scene))?;
     for m in &methods {

@@ -124,6 +124,7 @@ pub fn profile(args: ProfileArgs) -> Result<()> {
         max_depth: args.path.max_depth,
         camera: args.path.camera,
         seed: args.path.seed,
+        russian_roulette: args.path.russian_roulette.on(),
         ..Default::default()
     };
     settings.validate(&SceneInfo::of(&scene))?;

@@ -68,7 +68,7 @@ pub fn reference(args: ReferenceArgs) -> Result<()> {
         max_depth: args.path.max_depth,
         seed: args.path.seed,
         camera: args.path.camera,
-        ..Default::default()
+        russian_roulette: args.path.russian_roulette.on(),
     };
     settings.validate(&SceneInfo::of(&scene))?;
     create_parent(&args.out)?;

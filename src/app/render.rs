@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 
-use super::args::{parse_exposure, DeviceArgs, PathArgs, RestirArgs, SceneArgs, Toggle};
+use super::args::{parse_exposure, DeviceArgs, PathArgs, RestirArgs, SceneArgs};
 use super::render_loop::{render_path_traced, render_restir, Job};
 use super::render_output::{check_extension, create_parent, Outputs};
 use super::{finish_device, load_with_options, open_device};
@@ -48,11 +48,6 @@ pub struct RenderArgs {
     pub exposure: Exposure,
     #[command(flatten)]
     pub path: PathArgs,
-    /// Russian roulette from the third segment on (survival = max throughput, at most 0.95);
-    /// path tracer only, default on (ReSTIR PT does not use it: it traces every path to
-    /// --max-depth).
-    #[arg(long, value_enum)]
-    pub russian_roulette: Option<Toggle>,
     /// Render exactly F frames along the scene's camera path from --camera: its cameras in
     /// order, then back and forth (0, 1, ..., n-1, n-2, ..., 0, 1, ...). The last frame goes to
     /// --out; every frame too with --out-dir. `--frames 1` is one frame. Without --frames,
@@ -141,9 +136,6 @@ impl RenderArgs {
                 if self.spp.is_some() {
                     eprintln!("warning: --spp is ignored by ReSTIR PT, which renders frames (--time or --frames) of --candidates paths per pixel (--method pt uses it)");
                 }
-                if self.russian_roulette == Some(Toggle::On) {
-                    eprintln!("warning: --russian-roulette on is ignored by ReSTIR PT, which traces every path to --max-depth (--method pt uses it)");
-                }
             }
             MethodArg::Pt => {
                 let ignored = self.restir.changed_flags();
@@ -225,7 +217,7 @@ impl RenderArgs {
                 }),
             max_depth: self.path.max_depth,
             seed: self.path.seed,
-            russian_roulette: self.russian_roulette.is_none_or(Toggle::on),
+            russian_roulette: self.path.russian_roulette.on(),
             camera: self.path.camera,
         }
     }
@@ -334,6 +326,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::args::Toggle;
     use super::*;
 
     #[test]
@@ -344,9 +337,9 @@ mod tests {
         assert!(args.is_static());
         assert_eq!(args.path.max_depth, RenderSettings::DEFAULT_MAX_DEPTH);
         assert_eq!(args.restir_settings(), Some(RestirSettings::default()));
-        assert_eq!(args.russian_roulette, None);
+        assert_eq!(args.path.russian_roulette, Toggle::On);
         let pt: RenderArgs = super::super::parse_args(&["--method", "pt", "--russian-roulette", "off", "--exposure", "-1.5"]).unwrap();
-        assert_eq!((pt.restir_settings(), pt.russian_roulette), (None, Some(Toggle::Off)));
+        assert_eq!((pt.restir_settings(), pt.path.russian_roulette), (None, Toggle::Off));
         assert_eq!(pt.exposure, Exposure::Ev(-1.5));
         assert_eq!((pt.run_length(), pt.is_static()), (RunLength::Frames(1), false));
         assert_eq!(pt.settings_of_size(8, 8).spp, RenderSettings::DEFAULT_SPP);

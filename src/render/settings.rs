@@ -29,7 +29,8 @@ pub struct RenderSettings {
     pub max_depth: u32,
     /// Seeds every random number of the render: equal settings and seed give equal images.
     pub seed: u32,
-    /// Russian roulette in the path tracer; ReSTIR PT traces every path to `max_depth`.
+    /// Russian roulette in the path tracer's paths and ReSTIR PT's initial candidates (never in
+    /// its shifts; glsl/restir_candidates.glsl).
     pub russian_roulette: bool,
     /// Index into the scene's cameras.
     pub camera: usize,

@@ -8,6 +8,7 @@ use glam::Vec3;
 
 use crate::gpu_types::Material;
 use crate::scene::Scene;
+use crate::shader_interface::{RR_MAX_SURVIVAL, RR_START_DEPTH};
 use crate::shading::bsdf::{bsdf_eval_pdf, LOBE_DELTA, LOBE_NONE};
 use crate::shading::gris::{resampler_offer, target_function, Resampler};
 use crate::shading::path_record::PathRecord;
@@ -129,7 +130,12 @@ fn nee_candidate(
 }
 
 /// Streams every light-ending prefix of at most `max_length` vertices of the path from `y1`
-/// (seen from `camera`) with `seed`'s random numbers into `s`.
+/// (seen from `camera`) with `seed`'s random numbers into `s`. With `russian_roulette` the
+/// path goes on from x_i (i >= [`RR_START_DEPTH`]) with probability q = min(throughput /
+/// (product of the earlier q), [`RR_MAX_SURVIVAL`]), drawn from `STREAM_RESAMPLE`'s z at x_i;
+/// the later candidates' resampling weights are divided by the product of the q (their source
+/// pdf carries it) and their contributions are the path's own (Lin, Kettunen and Wyman 2026,
+/// "ReSTIR PT Enhanced": Russian roulette at initial sampling only).
 #[allow(clippy::too_many_arguments)]
 pub fn stream_path_candidates(
     scene: &Scene,
@@ -140,6 +146,7 @@ pub fn stream_path_candidates(
     max_length: usize,
     params: &ShiftParams,
     scale: f32,
+    russian_roulette: bool,
 ) -> CandidateCounts {
     let mut counts = CandidateCounts::default();
     let mut p = Path {
@@ -156,14 +163,23 @@ pub fn stream_path_candidates(
     let mut prefix = Vec3::ONE;
     let mut prev_pos = camera;
     let mut chosen = None;
+    // 1 / the product of the survival probabilities so far.
+    let mut roulette = 1.0f32;
     for i in 1..max_length {
         let x = p.vertices[i - 1];
         if vertex_is_escaped(&x) {
             break;
         }
+        let u = rng_uniform4(seed, i as u32, STREAM_RESAMPLE);
+        if russian_roulette && i as u32 >= RR_START_DEPTH {
+            let survive = (prefix.max_element() * roulette).min(RR_MAX_SURVIVAL);
+            if u.z >= survive {
+                break;
+            }
+            roulette /= survive;
+        }
         let wo = (prev_pos - x.pos).normalize();
         let (m, ns) = vertex_shading(scene, &x);
-        let u = rng_uniform4(seed, i as u32, STREAM_RESAMPLE);
         // NEE's techniques at x: the drawn light, then every directional light.
         for t in 0..=scene.directional_count {
             if let Some(c) = nee_candidate(scene, &x, &m, ns, wo, seed, i, t, prefix) {
@@ -172,7 +188,7 @@ pub fn stream_path_candidates(
                 } else {
                     rng_uniform4(seed, i as u32, STREAM_DIRECTIONAL + t - 1).x
                 };
-                if offer_candidate(s, &mut counts, c.contribution, scale, u_offer) {
+                if offer_candidate(s, &mut counts, c.contribution, scale * roulette, u_offer) {
                     chosen = Some(c);
                 }
             }
@@ -188,7 +204,7 @@ pub fn stream_path_candidates(
         if emitted.max_element() > 0.0 {
             let end_weight = end_mis_weight(scene, &x, prev_pos, &next, false, b.lobe & LOBE_DELTA != 0);
             let contribution = prefix * emitted * end_weight;
-            if contribution.max_element() > 0.0 && offer_candidate(s, &mut counts, contribution, scale, u.y) {
+            if contribution.max_element() > 0.0 && offer_candidate(s, &mut counts, contribution, scale * roulette, u.y) {
                 chosen = Some(TracedCandidate {
                     count: i + 1,
                     nee_end: false,

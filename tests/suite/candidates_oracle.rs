@@ -1,8 +1,8 @@
 //! GLSL `stream_path_candidates` (glsl/restir_candidates.glsl, the initial pass's candidates)
 //! against its Rust twin `stream_path_candidates` (src/shading/candidates.rs): one traced path
 //! per item from a primary hit of camera 0 with its own seed, its light-ending prefixes streamed
-//! into a fresh Resampler on both sides; the chosen record, the weight sum, W, the expectation
-//! and the pass counters compared.
+//! into a fresh Resampler on both sides, with and without Russian roulette; the chosen record,
+//! the weight sum, W, the expectation and the pass counters compared.
 
 use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
@@ -63,19 +63,42 @@ fn agrees(g: &[Vec4], record: &PathRecord, weight_sum: f32, w: f32, lost: bool, 
 #[test]
 fn stream_path_candidates_glsl_matches_rust() {
     let ctx = crate::common::gpu();
-    for name in ["cornell", "cornell-glossy", "glass", "env-ground", NORMAL_MAPPED_BOX] {
+    let scenes = [
+        ("cornell", true),
+        ("cornell-glossy", true),
+        ("glass", false),
+        ("env-ground", true),
+        (NORMAL_MAPPED_BOX, false),
+    ];
+    for (name, russian_roulette) in scenes {
         let scene = scene_named(name);
         let params = ShiftParams::for_scene(&scene);
         let items = primary_hits(&scene);
         let scale = 0.5f32;
-        let out = run_candidates_oracle(&ctx, &scene, &items, &params, scale);
+        let out = run_candidates_oracle(&ctx, &scene, &items, &params, scale, russian_roulette);
         let camera = scene.cameras[0].position;
-        let (mut chosen, mut differ, mut beyond_1e4, mut dropped) = (0, 0, 0, 0);
+        let (mut chosen, mut differ, mut beyond_1e4, mut dropped, mut cut) = (0, 0, 0, 0, 0);
         for (i, (y1, seed)) in items.iter().enumerate() {
             let g = &out[8 * i..8 * i + 8];
             let mut s = resampler_begin();
-            let counts = stream_path_candidates(&scene, &mut s, camera, *y1, *seed, MAX_PATH_LENGTH, &params, scale);
+            let counts = stream_path_candidates(
+                &scene,
+                &mut s,
+                camera,
+                *y1,
+                *seed,
+                MAX_PATH_LENGTH,
+                &params,
+                scale,
+                russian_roulette,
+            );
             let (record, w, _) = resampler_finish(&s);
+            if russian_roulette {
+                // Paths that the roulette changed, so that the flag is seen to reach the kernel.
+                let mut without = resampler_begin();
+                stream_path_candidates(&scene, &mut without, camera, *y1, *seed, MAX_PATH_LENGTH, &params, scale, false);
+                cut += (without.weight_sum != s.weight_sum) as usize;
+            }
             // Float fields only: the record's uint fields travel as float bits.
             assert!(
                 g[1..4].iter().chain(&g[5..]).all(|v| !v.is_nan()) && !g[4].truncate().is_nan(),
@@ -107,7 +130,14 @@ fn stream_path_candidates_glsl_matches_rust() {
                 }
             }
         }
-        eprintln!("{name}: {chosen} chosen paths agree, {beyond_1e4} beyond 1e-4, {differ} differ, {dropped} dropped, of {ITEMS}");
+        eprintln!(
+            "{name}: {chosen} chosen paths agree, {beyond_1e4} beyond 1e-4, {differ} differ, {dropped} dropped, {cut} changed by Russian roulette, of {ITEMS}"
+        );
+        assert_eq!(
+            cut > ITEMS / 20,
+            russian_roulette,
+            "{name}: {cut} paths changed by Russian roulette"
+        );
         assert!(differ * 1000 <= ITEMS, "{name}: {differ} items differ");
         assert!(beyond_1e4 * 100 <= ITEMS, "{name}: {beyond_1e4} items beyond 1e-4");
         assert!(chosen > ITEMS / 4, "{name}: only {chosen} items chose a path");
@@ -137,6 +167,7 @@ fn run_candidates_oracle(
     items: &[(Vertex, u32)],
     params: &ShiftParams,
     scale: f32,
+    russian_roulette: bool,
 ) -> Vec<Vec4> {
     let camera = scene.cameras[0].position;
     let scene_gpu = SceneGpu::upload(ctx, scene).unwrap();
@@ -147,7 +178,11 @@ fn run_candidates_oracle(
         BufferUsage::Params,
     )
     .unwrap();
-    frame.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
+    let settings = RenderSettings {
+        russian_roulette,
+        ..Default::default()
+    };
+    frame.write(&[settings.frame_params(scene_gpu.info())]).unwrap();
     let kernel_params = [
         MAX_PATH_LENGTH as u32,
         params.roughness_threshold.to_bits(),

@@ -62,7 +62,17 @@ fn gbh_weights_of_temporal_inputs_sum_to_one() {
                 continue;
             };
             let mut s = resampler_begin();
-            stream_path_candidates(&scene, &mut s, history_camera, x1_primary, seed, MAX_PATH_LENGTH, &params, 1.0);
+            stream_path_candidates(
+                &scene,
+                &mut s,
+                history_camera,
+                x1_primary,
+                seed,
+                MAX_PATH_LENGTH,
+                &params,
+                1.0,
+                true,
+            );
             let (Some(x1), w, _) = resampler_finish(&s) else { continue };
             if w <= 0.0 {
                 continue;
