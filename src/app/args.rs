@@ -78,9 +78,10 @@ pub struct RestirArgs {
     /// ReSTIR PT: spatial reuse rounds (1 to 3).
     #[arg(long, default_value_t = RestirSettings::default().rounds)]
     pub rounds: u32,
-    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M.
-    #[arg(long, default_value_t = RestirSettings::default().m_cap, allow_negative_numbers = true)]
-    pub m_cap: f32,
+    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M
+    /// (default 20; 2 where `render` averages a still camera's frames to a time budget).
+    #[arg(long, allow_negative_numbers = true)]
+    pub m_cap: Option<f32>,
     /// ReSTIR PT: initial paths traced per reservoir and frame.
     #[arg(long, default_value_t = RestirSettings::default().candidates)]
     pub candidates: u32,
@@ -106,7 +107,7 @@ impl RestirArgs {
             spatial: self.spatial,
             radius: self.radius,
             rounds: self.rounds,
-            m_cap: self.m_cap,
+            m_cap: self.m_cap.unwrap_or(RestirSettings::default().m_cap),
             candidates: self.candidates,
             reservoirs: self.reservoirs,
             emission_rays: self.emission_rays,
