@@ -38,12 +38,7 @@ fn restir_kernels_for_cameras_are_those_the_frames_dispatch() {
 #[test]
 fn restir_kernels_built_on_demand_render_the_same_frames_bit_for_bit() {
     let ctx = gpu();
-    let scene = SceneGpu::upload(&ctx, &load_scene(&repo_path("scenes/cornell.gltf")).unwrap()).unwrap();
-    let small = restir_pt::render::RenderSettings {
-        width: 24,
-        height: 16,
-        ..settings(1)
-    };
+    let (scene, small) = small_scene(&ctx, "cornell", 24, 16);
     let restir = RestirSettings::default();
     let mut every = Restir::new(&scene, &small, &restir).unwrap();
     let expected = frame_bits(&mut every);
@@ -59,6 +54,17 @@ fn restir_kernels_built_on_demand_render_the_same_frames_bit_for_bit() {
     assert!(lazy.compile_ms() > 0.0 && lazy.compile_cpu_ms() > 0.0);
     drop((every, lazy, scene));
     assert_clean(&ctx);
+}
+
+/// Bundled scene `name` uploaded to `ctx`, and settings of a `width` x `height` image of it.
+fn small_scene(ctx: &Arc<Context>, name: &str, width: u32, height: u32) -> (Arc<SceneGpu>, restir_pt::render::RenderSettings) {
+    let scene = load_scene(&repo_path(&format!("scenes/{name}.gltf"))).unwrap();
+    let settings = restir_pt::render::RenderSettings {
+        width,
+        height,
+        ..settings(1)
+    };
+    (SceneGpu::upload(ctx, &scene).unwrap(), settings)
 }
 
 /// The average's bits after each of five frames: three of a still camera (the unmoved
@@ -96,12 +102,7 @@ fn restir_kernels_warmed_up_on_a_twin_device_render_the_same_frames_bit_for_bit(
     let mesa_cache_off = std::env::var("MESA_SHADER_CACHE_DISABLE").is_ok_and(|v| v == "true" || v == "1");
     let expected_twin = cpu_device && cores >= 2 && !mesa_cache_off && std::env::var(TWIN_COMPILE_ENV).map_or(true, |v| v != "0");
     assert_eq!(twin_compile_pays(&ctx), expected_twin, "{} with {cores} cores", ctx.info.name);
-    let scene = SceneGpu::upload(&ctx, &load_scene(&repo_path("scenes/cornell-glossy.gltf")).unwrap()).unwrap();
-    let small = restir_pt::render::RenderSettings {
-        width: 20,
-        height: 12,
-        ..settings(3)
-    };
+    let (scene, small) = small_scene(&ctx, "cornell-glossy", 20, 12);
     let restir = RestirSettings::default();
     set_twin_compile(false);
     let alone = Restir::new(&scene, &small, &restir);
