@@ -192,12 +192,12 @@ pub const MAX_NEIGHBOURS: u32 = 8;
 pub const MAX_INPUTS: u32 = MAX_NEIGHBOURS + 1;
 /// Width and height of a 2D workgroup of the image kernels (pathtrace.comp, restir_*.comp).
 pub const IMAGE_LOCAL_SIZE: u32 = 8;
-/// Russian roulette (the path tracer's and ReSTIR PT's initial candidates) starts at path
-/// vertex x_3 (x_1 the primary hit): the first two bounces always continue.
+/// Russian roulette starts at path vertex x_3 (x_1 the primary hit): the path tracer decides
+/// there, after its NEE, whether to trace on; ReSTIR PT's initial candidates decide before
+/// their NEE at x_3 (glsl/restir_candidates.glsl). The first two bounces always continue.
 pub const RR_START_DEPTH: u32 = 3;
 /// Russian roulette's survival probability is the path throughput's largest channel, at most
-/// this, so that a path of throughput 1 still ends in time (pbrt-v4 uses 1 without a cap; the
-/// cap bounds the expected length in closed scenes of albedo near 1).
+/// this, so that paths of throughput near 1 (closed scenes of albedo near 1) still end.
 pub const RR_MAX_SURVIVAL: f32 = 0.95;
 /// Profile counters of glsl/counters.glsl, in its order (COUNTER_TRAVERSALS ...
 /// COUNTER_STEP_ITERATIONS), each a 64-bit sum.

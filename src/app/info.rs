@@ -51,7 +51,7 @@ pub fn info(args: InfoArgs) -> Result<()> {
         // One kernel at a time and no twin device, so that each stage's process CPU time is
         // that stage's alone.
         restir_pt::vk::set_compile_threads(0);
-        restir_pt::vk::set_twin_compile(false);
+        restir_pt::vk::set_twin_compile(restir_pt::vk::TwinCompile::Off);
         let mut reports = vec![PathTracer::new(&scene_gpu, &settings)?.compile_report().clone()];
         reports.extend(Restir::new(&scene_gpu, &settings, &restir)?.compile_reports());
         drop(scene_gpu);

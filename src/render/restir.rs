@@ -245,7 +245,7 @@ impl Restir {
             this.kernels[todo[i] as usize] = Some(k);
             Ok(())
         };
-        if todo.len() < 2 || !twin_compile_pays(&self.ctx) {
+        if todo.len() < 2 || !twin_compile_pays(&self.ctx, false) {
             compile_kernels_in_parallel(&jobs, |i, compiled| build_one(self, i, &compiled))?;
         } else {
             let mut compiled = Vec::new();
@@ -253,7 +253,11 @@ impl Restir {
                 compiled.push(c);
                 Ok(())
             })?;
-            let (mine, theirs) = halves_by_size(&compiled);
+            let (mine, theirs) = if twin_compile_pays(&self.ctx, compiled.iter().all(|c| c.from_cache)) {
+                halves_by_size(&compiled)
+            } else {
+                ((0..compiled.len()).collect(), Vec::new())
+            };
             let full_layout = scene_gpu.layout(layout.clone());
             let twin_kernels: Vec<TwinKernel> = theirs
                 .iter()
@@ -267,12 +271,12 @@ impl Restir {
             let ctx = self.ctx.clone();
             let mut this_twin_warmed = 0;
             std::thread::scope(|scope| -> Result<()> {
-                let twin = scope.spawn(move || warm_up_on_twin(&ctx, &twin_kernels));
+                let twin = (!twin_kernels.is_empty()).then(|| scope.spawn(move || warm_up_on_twin(&ctx, &twin_kernels)));
                 for &i in &mine {
                     build_one(self, i, &compiled[i])?;
                 }
                 // A twin that failed only leaves its kernels to be compiled here.
-                if matches!(twin.join(), Ok(Ok(()))) {
+                if matches!(twin.map(|t| t.join()), Some(Ok(Ok(())))) {
                     this_twin_warmed += theirs.len();
                 }
                 theirs.iter().try_for_each(|&i| build_one(self, i, &compiled[i]))

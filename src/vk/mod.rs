@@ -22,4 +22,4 @@ pub use shader::{
 };
 pub use spirv_cache::{cache_dir as spirv_cache_dir, SPIRV_CACHE_ENV};
 pub use timer::PassTimer;
-pub use twin_compile::{set_twin_compile, twin_compile_pays, warm_up_on_twin, TwinKernel, TWIN_COMPILE_ENV};
+pub use twin_compile::{set_twin_compile, twin_compile_pays, warm_up_on_twin, TwinCompile, TwinKernel, TWIN_COMPILE_ENV};

@@ -55,6 +55,12 @@ type CacheKey = (String, Vec<(String, String)>);
 /// Results are kept for the process (tests build the same kernels many times) and on disk
 /// across processes (`spirv_cache`).
 pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
+    Ok(compile_kernel_noting_cache(name, defines)?.0)
+}
+
+/// `compile_kernel`, and whether the SPIR-V came from a cache (the process's or the disk's)
+/// rather than from shaderc.
+fn compile_kernel_noting_cache(name: &str, defines: &[(&str, &str)]) -> Result<(Vec<u32>, bool)> {
     static CACHE: OnceLock<Mutex<HashMap<CacheKey, Vec<u32>>>> = OnceLock::new();
     let key = (
         name.to_string(),
@@ -62,16 +68,16 @@ pub fn compile_kernel(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> 
     );
     let cache = CACHE.get_or_init(Default::default);
     if let Some(spirv) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
-        return Ok(spirv);
+        return Ok((spirv, true));
     }
-    let spirv = match spirv_cache::cache_dir() {
-        Some(dir) => compile_kernel_cached_in(name, defines, &dir)?.0,
-        None => compile_glsl(name, defines)?,
+    let (spirv, from_disk) = match spirv_cache::cache_dir() {
+        Some(dir) => compile_kernel_cached_in(name, defines, &dir)?,
+        None => (compile_glsl(name, defines)?, false),
     };
     if let Ok(mut c) = cache.lock() {
         c.insert(key, spirv.clone());
     }
-    Ok(spirv)
+    Ok((spirv, from_disk))
 }
 
 /// One kernel's SPIR-V from [`compile_kernels_in_parallel`], with what compiling it cost.
@@ -83,6 +89,10 @@ pub struct CompiledKernel {
     /// CPU milliseconds its thread spent in `compile_kernel`, which other processes do not
     /// inflate as they do the wall-clock time.
     pub cpu_ms: f64,
+    /// Whether the SPIR-V came from restir-pt's SPIR-V cache (this process's or the disk's):
+    /// then this machine has most likely compiled the kernel before, and the driver's own
+    /// cache holds it too.
+    pub from_cache: bool,
 }
 
 /// The CPU time of the calling thread, in milliseconds (0 where the clock is unavailable).
@@ -119,11 +129,12 @@ pub fn set_compile_threads(threads: usize) {
 /// Compiles `name` with `defines`, timed on the calling thread.
 pub(super) fn compile_timed(name: &str, defines: &[(&str, &str)]) -> Result<CompiledKernel> {
     let (start, cpu) = (Instant::now(), thread_cpu_ms());
-    let spirv = compile_kernel(name, defines)?;
+    let (spirv, from_cache) = compile_kernel_noting_cache(name, defines)?;
     Ok(CompiledKernel {
         spirv,
         wall_ms: start.elapsed().as_secs_f64() * 1e3,
         cpu_ms: thread_cpu_ms() - cpu,
+        from_cache,
     })
 }
 

@@ -9,7 +9,7 @@
 //! finds the twin's half in the cache. The twin only fills a cache: every kernel is still
 //! created and dispatched on the renderer's own device, so images cannot differ.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::Arc;
 
 use anyhow::Result;
@@ -19,16 +19,43 @@ use super::shader::CompiledKernel;
 use super::BindingSlot;
 use super::{Binding, Buffer, BufferUsage, Context, ContextOptions, Kernel};
 
-/// Whether `twin_compile_pays` may say yes (see `set_twin_compile`).
-static TWIN_COMPILE: AtomicBool = AtomicBool::new(true);
+/// When a renderer may compile on a twin device (`set_twin_compile`, [`TWIN_COMPILE_ENV`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum TwinCompile {
+    /// Never.
+    Off,
+    /// Unless every kernel's SPIR-V came from restir-pt's SPIR-V cache: this machine then
+    /// compiled them before and the driver's cache most likely holds them, so a twin would
+    /// only add its device (0.25 s on a warm start of cornell-glossy). The default.
+    WhenCold,
+    /// Whenever the device allows it (tests, measurements).
+    Always,
+}
 
-/// The environment variable that switches twin compiles off when set to `0`.
+/// The process-wide `TwinCompile`, as its `u8`.
+static TWIN_COMPILE: AtomicU8 = AtomicU8::new(TwinCompile::WhenCold as u8);
+
+/// The environment variable that sets [`TwinCompile`]: `0` Off, `1` Always, unset WhenCold.
 pub const TWIN_COMPILE_ENV: &str = "RESTIR_PT_TWIN_COMPILE";
 
-/// Turns compiling on a twin device on or off for the whole process (on by default unless
-/// [`TWIN_COMPILE_ENV`] is `0`), e.g. to measure a start-up without it.
-pub fn set_twin_compile(on: bool) {
-    TWIN_COMPILE.store(on, Ordering::Relaxed);
+/// Sets when renderers of this process compile on a twin device; [`TWIN_COMPILE_ENV`], where
+/// set, overrides it.
+pub fn set_twin_compile(mode: TwinCompile) {
+    TWIN_COMPILE.store(mode as u8, Ordering::Relaxed);
+}
+
+/// The mode in force: [`TWIN_COMPILE_ENV`] if set to `0` or `1`, else `set_twin_compile`'s.
+fn twin_compile_mode() -> TwinCompile {
+    match std::env::var(TWIN_COMPILE_ENV).as_deref() {
+        Ok("0") => TwinCompile::Off,
+        Ok("1") => TwinCompile::Always,
+        _ => match TWIN_COMPILE.load(Ordering::Relaxed) {
+            0 => TwinCompile::Off,
+            1 => TwinCompile::WhenCold,
+            _ => TwinCompile::Always,
+        },
+    }
 }
 
 /// One kernel for [`warm_up_on_twin`]: its GLSL file name, SPIR-V, bindings of every set and
@@ -44,18 +71,23 @@ pub struct TwinKernel<'a> {
     pub push: &'a [u8],
 }
 
-/// Whether warming kernels up on a twin of `ctx`'s device can shorten a start-up: the device
-/// compiles at first dispatch into a disk cache (a CPU device: lavapipe), Mesa's disk cache is
-/// not switched off, the machine has a second core, and no validation layer is in the process
-/// (Debian 12's layer races between devices made on two threads; see
-/// [`ContextOptions::validation`]).
-pub fn twin_compile_pays(ctx: &Context) -> bool {
+/// Whether warming kernels up on a twin of `ctx`'s device can shorten a start-up whose
+/// kernels' SPIR-V all came from restir-pt's cache (`spirv_cached`) or not: the mode allows it
+/// ([`TwinCompile`]), the device compiles at first dispatch into a disk cache (a CPU device:
+/// lavapipe), Mesa's disk cache is not switched off, the machine has a second core, and no
+/// validation layer is in the process (Debian 12's layer races between devices made on two
+/// threads; see [`ContextOptions::validation`]).
+pub fn twin_compile_pays(ctx: &Context, spirv_cached: bool) -> bool {
     let env_on = |name: &str| std::env::var(name).is_ok_and(|v| matches!(v.to_lowercase().as_str(), "1" | "true" | "yes"));
     let layers_from_env = ["VK_INSTANCE_LAYERS", "VK_LOADER_LAYERS_ENABLE"]
         .iter()
         .any(|name| std::env::var(name).is_ok_and(|v| !v.is_empty()));
-    TWIN_COMPILE.load(Ordering::Relaxed)
-        && std::env::var(TWIN_COMPILE_ENV).map_or(true, |v| v != "0")
+    let allowed = match twin_compile_mode() {
+        TwinCompile::Off => false,
+        TwinCompile::WhenCold => !spirv_cached,
+        TwinCompile::Always => true,
+    };
+    allowed
         && ctx.info.device_type == vk::PhysicalDeviceType::CPU
         && !ctx.validated()
         && !layers_from_env
@@ -80,8 +112,8 @@ pub fn warm_up_on_twin(ctx: &Context, kernels: &[TwinKernel]) -> Result<()> {
         ..Default::default()
     })?);
     for k in kernels {
-        // A binding's buffer is as large as a block may be bound (uniform) or 64 KiB, so that
-        // a dispatch reading a parameter block reads zeros.
+        // 64 KiB of zeros per binding (a uniform one at most maxUniformBufferRange), so that a
+        // dispatch reading its parameter block reads an image of zero pixels.
         let buffers = k
             .layout
             .iter()

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use restir_pt::render::{PassKernel, Restir, RestirSettings, SceneGpu};
 use restir_pt::scene::load_scene;
-use restir_pt::vk::{set_twin_compile, twin_compile_pays, Context, ContextOptions, TWIN_COMPILE_ENV};
+use restir_pt::vk::{set_twin_compile, twin_compile_pays, Context, ContextOptions, TwinCompile, TWIN_COMPILE_ENV};
 
 use crate::common::{assert_clean, gpu, repo_path, temp_file};
 use crate::restir_unbiased::settings;
@@ -95,24 +95,38 @@ fn assert_same_frames(got: &[Vec<u32>], expected: &[Vec<u32>]) {
 // devices on two threads).
 #[test]
 fn restir_kernels_warmed_up_on_a_twin_device_render_the_same_frames_bit_for_bit() {
-    assert!(!twin_compile_pays(&gpu()), "a validated device must not get a twin");
+    assert!(!twin_compile_pays(&gpu(), false), "a validated device must not get a twin");
     let ctx = Arc::new(Context::new(&ContextOptions::default()).unwrap());
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let cpu_device = ctx.info.device_type == ash::vk::PhysicalDeviceType::CPU;
     let mesa_cache_off = std::env::var("MESA_SHADER_CACHE_DISABLE").is_ok_and(|v| v == "true" || v == "1");
     let expected_twin = cpu_device && cores >= 2 && !mesa_cache_off && std::env::var(TWIN_COMPILE_ENV).map_or(true, |v| v != "0");
-    assert_eq!(twin_compile_pays(&ctx), expected_twin, "{} with {cores} cores", ctx.info.name);
+    assert_eq!(
+        twin_compile_pays(&ctx, false),
+        expected_twin,
+        "{} with {cores} cores",
+        ctx.info.name
+    );
     let (scene, small) = small_scene(&ctx, "cornell-glossy", 20, 12);
     let restir = RestirSettings::default();
-    set_twin_compile(false);
+    set_twin_compile(TwinCompile::Off);
     let alone = Restir::new(&scene, &small, &restir);
-    set_twin_compile(true);
+    // The kernels' SPIR-V now comes from the process's cache, which WhenCold takes for a warm
+    // driver cache.
+    set_twin_compile(TwinCompile::Always);
     let expected = frame_bits(&mut alone.unwrap());
     let mut twinned = Restir::new(&scene, &small, &restir).unwrap();
     assert_eq!(twinned.compile_reports().len(), PassKernel::ALL.len());
     let warmed = twinned.twin_warmed_kernels();
     let expected_warmed = if expected_twin { 1..PassKernel::ALL.len() } else { 0..1 };
     assert!(expected_warmed.contains(&warmed), "{warmed} kernels warmed on the twin");
+    set_twin_compile(TwinCompile::WhenCold);
+    if std::env::var(TWIN_COMPILE_ENV).is_err() {
+        assert!(
+            !twin_compile_pays(&ctx, true),
+            "kernels whose SPIR-V was cached must not get a twin"
+        );
+    }
     assert_same_frames(&frame_bits(&mut twinned), &expected);
 }
 
