@@ -16,8 +16,7 @@ use anyhow::Result;
 use ash::vk;
 
 use super::shader::CompiledKernel;
-use super::BindingSlot;
-use super::{Binding, Buffer, BufferUsage, Context, ContextOptions, Kernel};
+use super::{Binding, BindingSlot, Buffer, BufferUsage, Context, ContextOptions, Kernel};
 
 /// When a renderer may compile on a twin device (`set_twin_compile`, [`TWIN_COMPILE_ENV`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
