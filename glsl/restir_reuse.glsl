@@ -1,8 +1,7 @@
-// GRIS across pixels and frames (docs/restir.md): inputs from other domains are shifted into the
-// canonical pixel's domain, weighted by resampling MIS weights (gris.glsl) computed with inverse
-// shifts, and one is chosen by the streaming resampler (reservoir.glsl). The estimator is
-// src/shading/gris.rs's, whose toy test checks it; SHIFT_MODE and MIS_MODE select the shift and the MIS
-// at compile time.
+// GRIS across pixels and frames (docs/restir.md): the domains of ReSTIR PT's reservoirs (a pixel
+// seen from a frame's camera) and the shifts between them, the bridge on which the reuse loop
+// (resample_inputs.glsl) runs: input_reservoir, input_domain, same_domain and shift_path.
+// SHIFT_MODE and MIS_MODE select the shift and the MIS at compile time.
 #ifndef RESTIR_REUSE_GLSL
 #define RESTIR_REUSE_GLSL
 
@@ -85,6 +84,10 @@ bool domain_primary(Domain d, PathRecord record, out vec3 camera, out Vertex y1)
     return true;
 }
 
+Domain input_domain(uint i) {
+    return inputs[i].domain;
+}
+
 ShiftParams reuse_shift_params() {
     return ShiftParams(roughness_threshold, distance_threshold);
 }
@@ -115,83 +118,11 @@ ShiftResult shift_path(PathRecord record, Domain to) {
         s = inverse_hybrid(reuse_shift_params(), record, camera, v1);
 #endif
     }
-    if (!s.valid) local_shifts_failed += 1u;
     return s;
 }
 
-// Resamples inputs[0..n-1] (0: the canonical pixel's own reservoir) into one reservoir of the
-// canonical domain; `seed` keys the choice. `expected` receives E[f(Y) W_Y] over the choice.
-//
-// Step (i, l) of the n x n steps makes at most one shift: for l = 0 the shift of input i's
-// sample into the canonical domain, y_i = T_i(X_i); for l >= 1 (l != i) the inverse shift of y_i
-// into domain l, for p̂_{<-l}(y_i). Every shift goes through the one call below: a kernel
-// inlines each call site whole, and llvmpipe's compile time grows with the copies
-// (docs/lab-notebook.md, "Compile time of the reuse kernels").
-Reservoir resample_inputs(uint n, uint seed, out vec3 expected) {
-    Resampler s = resampler_begin();
-    PathRecord y = reservoir_empty().record;
-    float W = 0.0;
-    float own_target = 0.0;
-    float jacobian = 1.0;
-    bool alive = false;
-    for (uint step = 0u; step < n * n; ++step) {
-        loop_tick();
-        uint i = step / n;
-        uint l = step % n;
-        bool forward = l == 0u;
-        if (forward) {
-            s.confidence += confidences[i];
-            // An empty reservoir offers no sample, but its domain still counts in the MIS weights.
-            Reservoir res = input_reservoir(i);
-            W = res.W;
-            own_target = target_function(res.record.contribution);
-            alive = W > 0.0;
-            y = res.record;
-            jacobian = 1.0;
-        }
-        Domain from = forward ? inputs[i].domain : inputs[0].domain;
-        Domain to = forward ? inputs[0].domain : inputs[l].domain;
-        bool wanted = forward || (l != i && needs_targets_from(i));
-        bool shift = alive && wanted && !same_domain(from, to);
-        ShiftResult shifted = shift_failed();
-        if (shift) shifted = shift_path(y, to);
-        if (forward) {
-            if (shift && shifted.valid) {
-                y = shifted.record;
-                jacobian = shifted.jacobian;
-            }
-            alive = alive && (!shift || shifted.valid);
-            float p0 = target_function(y.contribution);
-            targets_from[0] = p0;
-            // For input i itself the inverse shift returns its own sample, whose p̂ it carries.
-            if (i != 0u) targets_from[i] = own_target / jacobian;
-        } else if (alive && wanted) {
-            float t = target_function(y.contribution);
-            if (shift) {
-                t = shifted.valid ? target_function(shifted.contribution) * shifted.jacobian : 0.0;
-                // A non-finite value counts as a failed shift.
-                if (!is_finite(t)) {
-                    local_nonfinite_weights += 1u;
-                    local_shifts_failed += 1u;
-                    t = 0.0;
-                }
-            }
-            targets_from[l] = t;
-        }
-        if (l + 1u == n && alive) {
-            float p0 = targets_from[0];
-            float w = mis_weight(n, i) * p0 * W * jacobian;
-            if (!is_finite(w)) {
-                local_nonfinite_weights += 1u;
-                if (!same_domain(inputs[i].domain, inputs[0].domain)) local_shifts_failed += 1u;
-            } else if (w > 0.0) {
-                resampler_add(s, y, p0, w, rng_uniform4(seed, i, STREAM_RESAMPLE).x);
-            }
-        }
-    }
-    expected = s.expected;
-    return resampler_finish(s);
-}
+// The reuse loop, on the bridge above.
+#include "resample_inputs.glsl"
 
 // Whether a neighbour's primary hit is similar enough to the canonical one to be reused: both
 // hit a surface, normals agree, and the neighbour's depth agrees with the canonical point's

@@ -1,11 +1,12 @@
 // Paths regenerated in primary sample space from a primary hit and a seed (random replay's
-// map, and the replayed prefix of the hybrid shift), and the result every shift returns.
+// map, and the replayed prefix of the hybrid shift).
 // Expects the scene bindings. Twin: src/shading/shift/path.rs.
 #ifndef SHIFT_PATH_GLSL
 #define SHIFT_PATH_GLSL
 
 #include "path_record.glsl"
 #include "rng.glsl"
+#include "shift_result.glsl"
 #include "shift_vertex.glsl"
 
 // A path x1..xk. Its vertices, lobes and weights are not members but the invocation's rows of
@@ -35,18 +36,6 @@ void set_path_vertex(uint i, Vertex v) { path_vertices[path_row(i)] = v; }
 void set_path_lobe(uint i, uint lobe) { path_lobes[path_row(i)] = lobe; }
 void set_path_weight(uint i, vec3 w) { path_weights[path_row(i)] = w; }
 
-struct ShiftResult {
-    bool valid;
-    PathRecord record;
-    float jacobian;
-    vec3 contribution;
-#ifdef SHIFT_ORACLE
-    // The vertices the shift made (see src/shading/shift/path.rs), which only the oracle test compares:
-    // production kernels would copy them on every shift.
-    uint vertex_count;
-    vec3 vertices[MAX_PATH_LENGTH];
-#endif
-};
 // The first r >= 2 whose pair (x_{r-1}, x_r) is reconnectable; 0 if none.
 uint reconnection_index(Path path, ShiftParams params) {
     for (uint r = 2u; r <= path.count; ++r) {
@@ -177,17 +166,6 @@ bool finish_path(inout Path path) {
     }
     path.contribution = c;
     return max_component(c) > 0.0;
-}
-
-ShiftResult shift_failed() {
-    ShiftResult s;
-    s.valid = false;
-    s.jacobian = 0.0;
-    s.contribution = vec3(0.0);
-#ifdef SHIFT_ORACLE
-    s.vertex_count = 0u;
-#endif
-    return s;
 }
 
 // A non-finite or non-positive Jacobian counts as a failed shift, never as a value.

@@ -32,6 +32,7 @@ mod real_scenes_cli;
 mod restir;
 mod restir_unbiased;
 mod restir_unbiased_metal;
+mod reuse_oracle;
 mod rng_oracle;
 mod robustness;
 mod sampling_oracle;
