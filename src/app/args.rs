@@ -78,7 +78,8 @@ pub struct RestirArgs {
     /// ReSTIR PT: spatial reuse rounds (1 to 3).
     #[arg(long, default_value_t = RestirSettings::default().rounds)]
     pub rounds: u32,
-    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M
+    /// ReSTIR PT: the temporal input's confidence is capped at this multiple of the current M,
+    /// and an unmoved camera's running mean of the directly seen emission at this many frames
     /// (default 20; 2 where `render` averages a still camera's frames to a time budget).
     #[arg(long, allow_negative_numbers = true)]
     pub m_cap: Option<f32>,
@@ -218,8 +219,9 @@ pub struct PathArgs {
     /// Seed of the random numbers; runs of the same seed and settings are identical.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
-    /// Russian roulette from the path's third vertex on (survival = its throughput, at most
-    /// 0.95): the path tracer's paths and ReSTIR PT's initial candidates, never its shifts.
+    /// Russian roulette from the path's third vertex on (survival = the largest channel of its
+    /// throughput, at most 0.95): the path tracer's paths and ReSTIR PT's initial candidates,
+    /// never its shifts.
     #[arg(long, value_enum, default_value = "on")]
     pub russian_roulette: Toggle,
 }

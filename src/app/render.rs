@@ -1,6 +1,7 @@
 //! `restir-pt render`: ReSTIR PT frames or progressive path tracing to EXR/PNG, with a one-line
 //! summary per frame; its options and how long a run lasts (render_loop.rs runs the frames).
 
+use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -86,6 +87,9 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub device: DeviceArgs,
 }
+
+/// How much of a scene file is read before the device opens, to tell glTF from other files.
+const GLTF_START_BYTES: u64 = 4096;
 
 /// GPU seconds of frames that ReSTIR PT renders and averages without --frames or --time.
 pub const DEFAULT_TIME_S: f64 = 8.0;
@@ -175,11 +179,18 @@ impl RenderArgs {
     }
 
     /// What [`RenderArgs::settings`] checks without the scene, and that the scene file can be
-    /// opened, so that bad input fails before the device opens (a second or more on lavapipe).
+    /// read and starts as glTF does, so that bad input fails before the device opens (a second or more on lavapipe).
     /// The image size is checked here when both sides are given; a side the camera completes
     /// waits for the scene.
     fn check_before_device(&self, scene_path: &Path) -> Result<()> {
-        std::fs::File::open(scene_path).map_err(|e| anyhow!("{}: cannot read the file: {e}", scene_path.display()))?;
+        let cannot_read = |e: std::io::Error| anyhow!("{}: cannot read the file: {e}", scene_path.display());
+        let mut start = Vec::with_capacity(GLTF_START_BYTES as usize);
+        std::fs::File::open(scene_path)
+            .map_err(cannot_read)?
+            .take(GLTF_START_BYTES)
+            .read_to_end(&mut start)
+            .map_err(cannot_read)?;
+        restir_pt::scene::check_gltf_start(&start, start.len() < GLTF_START_BYTES as usize, scene_path)?;
         let (width, height) = match (self.width, self.height) {
             (Some(w), Some(h)) => (w, h),
             // A valid stand-in: only spp and depth are checked.

@@ -90,23 +90,44 @@ fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<GltfChunks<'a>> {
 /// The first non-blank byte of JSON text: an object's or an array's opening bracket (RFC 8259).
 const JSON_TEXT_START: [u8; 2] = [b'{', b'['];
 
+/// Why bytes that are neither GLB nor parseable JSON are no glTF file, from their first
+/// non-blank byte (`None`: there is none): past leading white space JSON text starts with a
+/// bracket; anything else is another kind of file (an image, an OBJ, a Blender file), which a
+/// JSON parser's position says little about. `None` where they may be glTF JSON.
+fn not_gltf_reason(first_non_blank: Option<&u8>) -> Option<&'static str> {
+    match first_non_blank {
+        Some(b) if JSON_TEXT_START.contains(b) => None,
+        None => Some("the file is empty, not a glTF file"),
+        Some(_) => Some("not a glTF file: neither glTF JSON (.gltf) nor binary glTF (.glb); convert it to glTF 2.0"),
+    }
+}
+
+/// Checks that a file whose first bytes are `start` (all of it if `start` is the whole file,
+/// `whole`) can be glTF: the GLB magic, or JSON text. Fails with the loader's own message
+/// otherwise, so that a command can refuse the file before the slow work that comes before
+/// loading it (opening a device).
+pub fn check_gltf_start(start: &[u8], whole: bool, path: &Path) -> Result<()> {
+    if start.starts_with(GLB_MAGIC) {
+        return Ok(());
+    }
+    let first = start.iter().find(|b| !b.is_ascii_whitespace());
+    match not_gltf_reason(first) {
+        // White space up to the end of a prefix says nothing yet.
+        Some(_) if first.is_none() && !whole => Ok(()),
+        Some(reason) => bail!(problem(path, reason)),
+        None => Ok(()),
+    }
+}
+
 /// Reads the JSON and applies the checks and removals described in the module comment;
 /// `warn` receives each warning (without the file name).
 pub(super) fn read_raw(bytes: &[u8], path: &Path, warn: &mut dyn FnMut(String)) -> Result<RawGltf> {
     let (json_bytes, blob) = split_glb(bytes, path)?;
-    let mut json: Value = serde_json::from_slice(&json_bytes).map_err(|e| {
-        // Past leading white space JSON text starts with a bracket; anything else is another
-        // kind of file (an image, an OBJ, a Blender file), which a parser's position says little about.
-        let first = json_bytes.iter().find(|b| !b.is_ascii_whitespace());
-        match first {
-            Some(b) if JSON_TEXT_START.contains(b) => problem(path, format!("invalid glTF: {e}")),
-            None => problem(path, "the file is empty, not a glTF file"),
-            Some(_) => problem(
-                path,
-                "not a glTF file: neither glTF JSON (.gltf) nor binary glTF (.glb); convert it to glTF 2.0",
-            ),
-        }
-    })?;
+    let mut json: Value =
+        serde_json::from_slice(&json_bytes).map_err(|e| match not_gltf_reason(json_bytes.iter().find(|b| !b.is_ascii_whitespace())) {
+            Some(reason) => problem(path, reason),
+            None => problem(path, format!("invalid glTF: {e}")),
+        })?;
     if !json.is_object() {
         bail!(problem(path, "invalid glTF: the top level is not a JSON object"));
     }

@@ -116,12 +116,17 @@ fn cli_bad_input_fails_with_one_clear_line() {
     );
 }
 
-/// A missing scene file and numbers out of range fail before the device opens (no `device:`
-/// line): they need no Vulkan, which takes a second or more to start on lavapipe.
+/// A missing scene file, a file that is no glTF and numbers out of range fail before the device
+/// opens (no `device:` line): they need no Vulkan, which takes a second or more to start on
+/// lavapipe.
 #[test]
 fn cli_bad_input_fails_before_the_device_opens() {
+    let not_gltf = temp_file("notes.gltf", b"# restir-pt\nnot a scene\n");
+    let empty = temp_file("empty.gltf", b"  \n");
     for args in [
         &["render", "no/such/scene.gltf"][..],
+        &["render", not_gltf.to_str().unwrap()],
+        &["render", empty.to_str().unwrap()],
         &["render", "--width", "100000", "--height", "100000"],
         &["render", "--method", "pt", "--spp", "0"],
         &["render", "--max-depth", "0"],
