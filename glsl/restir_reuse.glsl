@@ -1,7 +1,7 @@
 // GRIS across pixels and frames (docs/restir.md): inputs from other domains are shifted into the
 // canonical pixel's domain, weighted by resampling MIS weights (gris.glsl) computed with inverse
 // shifts, and one is chosen by the streaming resampler (reservoir.glsl). The estimator is
-// src/shading/gris.rs's, whose toy test checks it; SHIFT_MODE and MIS_MODE select the shift and the MIS
+// crates/shading-core/src/gris.rs's, whose toy test checks it; SHIFT_MODE and MIS_MODE select the shift and the MIS
 // at compile time.
 #ifndef RESTIR_REUSE_GLSL
 #define RESTIR_REUSE_GLSL

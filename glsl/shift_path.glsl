@@ -1,6 +1,6 @@
 // Paths regenerated in primary sample space from a primary hit and a seed (random replay's
 // map, and the replayed prefix of the hybrid shift), and the result every shift returns.
-// Expects the scene bindings. Twin: src/shading/shift/path.rs.
+// Expects the scene bindings. Twin: crates/shading/src/shift/path.rs.
 #ifndef SHIFT_PATH_GLSL
 #define SHIFT_PATH_GLSL
 
@@ -41,7 +41,7 @@ struct ShiftResult {
     float jacobian;
     vec3 contribution;
 #ifdef SHIFT_ORACLE
-    // The vertices the shift made (see src/shading/shift/path.rs), which only the oracle test compares:
+    // The vertices the shift made (see crates/shading/src/shift/path.rs), which only the oracle test compares:
     // production kernels would copy them on every shift.
     uint vertex_count;
     vec3 vertices[MAX_PATH_LENGTH];

@@ -1,5 +1,6 @@
-//! Embeds every file under glsl/ into the binary so that kernels compile from any working
-//! directory, and the `#include` resolver sees exactly the sources that were built.
+//! Embeds every file under the repository's glsl/ (two folders up from this crate) into the
+//! library so that kernels compile from any working directory, and the `#include` resolver sees
+//! exactly the sources that were built.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -21,34 +22,6 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<(String, PathBuf)>) {
     }
 }
 
-/// `git rev-parse --short HEAD` of the crate, or "unknown" without git or outside a repository;
-/// rebuilds when HEAD moves.
-fn embed_commit() {
-    let dir = manifest_dir();
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .current_dir(&dir)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .and_then(|o| String::from_utf8(o.stdout).ok())
-            .map(|s| s.trim().to_string())
-            .filter(|s| !s.is_empty())
-    };
-    let commit = git(&["rev-parse", "--short", "HEAD"]).unwrap_or_else(|| "unknown".into());
-    println!("cargo:rustc-env=RESTIR_PT_COMMIT={commit}");
-    let head_ref = git(&["symbolic-ref", "-q", "HEAD"]);
-    for name in ["HEAD", "packed-refs"].into_iter().map(String::from).chain(head_ref) {
-        if let Some(path) = git(&["rev-parse", "--git-path", &name]) {
-            let path = Path::new(&dir).join(path);
-            if path.exists() {
-                println!("cargo:rerun-if-changed={}", path.display());
-            }
-        }
-    }
-}
-
 /// The crate's folder, read when the script runs: `env!` would bake in the folder the script was
 /// compiled in, and a build script reused from another checkout (a copied target/) would then
 /// embed that checkout's kernels.
@@ -57,9 +30,8 @@ fn manifest_dir() -> String {
 }
 
 fn main() {
-    embed_commit();
-    let root = Path::new(&manifest_dir()).join("glsl");
-    println!("cargo:rerun-if-changed=glsl");
+    let root = Path::new(&manifest_dir()).join("../../glsl");
+    println!("cargo:rerun-if-changed=../../glsl");
     let mut files = Vec::new();
     collect(&root, &root, &mut files);
     let mut table = String::from("&[\n");

@@ -1,6 +1,6 @@
 //! Host twins of the records in glsl/types.glsl; `#[repr(C)]` so that a test can check offsets.
 //! Positions are in scene coordinates: world space moved by -`Scene::origin`
-//! ([`crate::scene::Scene`]).
+//! (`restir_pt_scene::Scene`).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -23,7 +23,7 @@ pub const MATERIAL_BLEND_EMISSION: u32 = 8;
 pub const NO_EMITTER: u32 = u32::MAX;
 
 /// A material's constant factors, as the kernels read them (glsl/types.glsl `Material`, 64 bytes,
-/// std430); textures scale them per hit (see [`crate::shading::texture`]). The BSDF built from it is
+/// std430); textures scale them per hit (see `restir_pt_shading::texture`). The BSDF built from it is
 /// described in docs/materials.md.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -36,7 +36,7 @@ pub struct Material {
     /// `KHR_materials_emissive_strength`.
     pub emission: [f32; 3],
     /// Perceptual (linear) roughness in [0, 1]; the GGX alpha is its square
-    /// ([`crate::shading::bsdf::ggx_alpha`]).
+    /// (`restir_pt_shading::bsdf::ggx_alpha`).
     pub roughness: f32,
     /// `KHR_materials_transmission` transmissionFactor in [0, 1]: the dielectric interface lobe
     /// replaces that share of the non-metal part only (weights `bsdf::lobe_weights`).
@@ -73,8 +73,8 @@ pub struct Triangle {
     /// Vertex 2 minus vertex 0, scene coordinates.
     pub e2: [f32; 3],
     /// 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0, set by
-    /// [`crate::scene::Scene::build`]: the traversal loops tell alpha-tested hits apart by it
-    /// without loading materials (glsl/alpha_pass.glsl, [`crate::shading::alpha_pass`]).
+    /// `restir_pt_scene::Scene::build`: the traversal loops tell alpha-tested hits apart by it
+    /// without loading materials (glsl/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
     pub alpha_tested: u32,
 }
 
@@ -114,7 +114,7 @@ impl BvhNode {
 /// leaves of the light tree ([`LightNode`]); each row keeps the path from the tree's root to its
 /// leaf so that the selection probability can be recomputed at any shading point. The light
 /// tree, the punctual lights' parameter rows and the environment map follow in the same buffer
-/// ([`LightNode::rows`], [`punctual_rows`]), each 16-byte row read as four 32-bit words.
+/// ([`LightNode::rows`], `restir_pt_scene::Scene::punctual_rows`), each 16-byte row read as four 32-bit words.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Emitter {
@@ -151,24 +151,6 @@ pub const PUNCTUAL_LIGHT_BIT: u32 = 1 << 31;
 /// Rows of the emitter buffer per punctual light, after the light tree (glsl/types.glsl):
 /// (position, kind), (direction, cos outer), (intensity, cos inner), (emitter row, 0, 0, 0).
 pub const PUNCTUAL_ROWS: usize = 4;
-
-/// The emitter-buffer rows of punctual lights (`emitter_rows[k]`: the row of light k among the
-/// [`Emitter`]s), reinterpreting each 16-byte row as four 32-bit words.
-pub fn punctual_rows(lights: &[crate::scene::PunctualLight], emitter_rows: &[u32]) -> Vec<Emitter> {
-    let row = |a: [f32; 3], w: u32| Emitter::from_words([a[0].to_bits(), a[1].to_bits(), a[2].to_bits(), w]);
-    lights
-        .iter()
-        .zip(emitter_rows)
-        .flat_map(|(l, &r)| {
-            [
-                row(l.position.into(), l.kind as u32),
-                row(l.direction.into(), l.cos_outer.to_bits()),
-                row(l.intensity.into(), l.cos_inner.to_bits()),
-                Emitter::from_words([r, 0, 0, 0]),
-            ]
-        })
-        .collect()
-}
 
 /// [`LightNode::flags`] bit: a leaf, whose `child` is the light's emitter row.
 pub const LIGHT_NODE_LEAF: u32 = 1;
@@ -255,7 +237,7 @@ pub const FLAG_RUSSIAN_ROULETTE: u32 = 1;
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct FrameParams {
     /// xyz: camera position, scene coordinates; w: tan(vertical field of view / 2) for this image
-    /// ([`crate::scene::Camera::fill_params`]).
+    /// (`restir_pt_scene::Camera::fill_params`).
     pub cam_position: [f32; 4],
     /// xyz: the camera's unit right axis, scene coordinates; w: aspect ratio width / height.
     pub cam_right: [f32; 4],
@@ -271,7 +253,7 @@ pub struct FrameParams {
     /// Image height in pixels.
     pub height: u32,
     /// Sample index of a pixel's first path in this dispatch; with `render_seed` it keys the
-    /// path's random numbers ([`crate::shading::rng::path_seed`]).
+    /// path's random numbers (`restir_pt_shading::rng::path_seed`).
     pub sample_offset: u32,
     /// Paths each pixel adds to its sums in one path-tracer dispatch.
     pub samples_per_dispatch: u32,
@@ -303,7 +285,7 @@ pub struct ReuseParams {
     /// The previous frame's viewing direction, as [`FrameParams::cam_forward`].
     pub prev_cam_forward: [f32; 4],
     /// Perceptual roughness below which a glossy vertex cannot be a reconnection vertex
-    /// ([`crate::shading::shift::ShiftParams`]).
+    /// (`restir_pt_shading::shift::ShiftParams`).
     pub roughness_threshold: f32,
     /// Minimum distance, in scene units, between a reconnection vertex and its predecessor.
     pub distance_threshold: f32,
@@ -341,7 +323,7 @@ pub struct ReuseParams {
 pub struct Surface {
     /// Hit point of the ray through the pixel centre, scene coordinates.
     pub pos: [f32; 3],
-    /// The hit triangle, or [`crate::scene::bvh::NO_HIT`] if the camera ray escaped.
+    /// The hit triangle, or `restir_pt_shading::bvh::NO_HIT` if the camera ray escaped.
     pub triangle: u32,
     /// The camera position the ray left from, scene coordinates.
     pub camera: [f32; 3],
@@ -353,21 +335,21 @@ pub struct Surface {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ReservoirHead {
-    /// [`crate::shading::path_record::PathRecord::seed`].
+    /// `restir_pt_shading::path_record::PathRecord::seed`.
     pub seed: u32,
-    /// [`crate::shading::path_record::PathRecord::info`].
+    /// `restir_pt_shading::path_record::PathRecord::info`.
     pub info: u32,
-    /// [`crate::shading::path_record::PathRecord::lobes`].
+    /// `restir_pt_shading::path_record::PathRecord::lobes`.
     pub lobes: u32,
-    /// [`crate::shading::path_record::PathRecord::rc_triangle`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_triangle`.
     pub rc_triangle: u32,
-    /// [`crate::shading::path_record::PathRecord::rc_pos`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_pos`.
     pub rc_pos: [f32; 3],
-    /// [`crate::shading::path_record::PathRecord::rc_pdf`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_pdf`.
     pub rc_pdf: f32,
-    /// [`crate::shading::path_record::PathRecord::rc_next`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_next`.
     pub rc_next: [f32; 3],
-    /// [`crate::shading::path_record::PathRecord::rc_geometry`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_geometry`.
     pub rc_geometry: f32,
 }
 
@@ -375,13 +357,13 @@ pub struct ReservoirHead {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ReservoirTail {
-    /// [`crate::shading::path_record::PathRecord::suffix`].
+    /// `restir_pt_shading::path_record::PathRecord::suffix`.
     pub suffix: [f32; 3],
-    /// [`crate::shading::path_record::PathRecord::rc_pdf_after`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_pdf_after`.
     pub rc_pdf_after: f32,
-    /// [`crate::shading::path_record::PathRecord::contribution`].
+    /// `restir_pt_shading::path_record::PathRecord::contribution`.
     pub contribution: [f32; 3],
-    /// [`crate::shading::path_record::PathRecord::rc_next_triangle`].
+    /// `restir_pt_shading::path_record::PathRecord::rc_next_triangle`.
     pub rc_next_triangle: u32,
     /// The unbiased contribution weight W.
     pub weight: f32,
@@ -400,7 +382,7 @@ pub struct RestirStats {
     /// The most iterations any subgroup's guarded loop ran (glsl/loop_budget.glsl).
     pub max_loop_iterations: u32,
     /// Subgroups whose loop hit the iteration budget and was cut short (reported as
-    /// [`crate::error::GpuError::LoopLimit`]).
+    /// `restir_pt_vk::error::GpuError::LoopLimit`).
     pub loop_budget_cut_groups: u32,
     /// Shift mappings attempted by the reuse passes.
     pub shifts_attempted: u32,

@@ -1,19 +1,29 @@
 //! The one statement of what the host and the GLSL kernels share besides struct layouts
-//! (those are src/gpu_types.rs, checked by tests/suite/layout.rs): descriptor bindings, the
+//! (those are crates/interface/src/gpu_types.rs, checked by tests/suite/layout.rs): descriptor bindings, the
 //! values of compile-time enums and the limits both sides size arrays by.
 //!
 //! Kernels see it as the header `shader_interface.glsl`, generated from this module by
-//! [`glsl_header`] and served to `#include` by src/vk/shader.rs, so no number here is
+//! [`glsl_header`] and served to `#include` by crates/vk/src/shader.rs, so no number here is
 //! written a second time in GLSL. Each binding is a Rust enum variant whose name is the GLSL
 //! block name; the header defines `<FAMILY>_BINDING_<NAME>` as its number, the host binds
-//! buffers by variant ([`crate::vk::Kernel::bind`]) and `Kernel::new` refuses a kernel whose
-//! SPIR-V declares another block at a binding than the one named here.
+//! buffers by variant (`restir_pt_vk::Kernel::bind`, through `restir_pt_vk::BindingFamilyExt`)
+//! and `Kernel::new` refuses a kernel whose SPIR-V declares another block at a binding than the
+//! one named here.
 
 use std::fmt::Write as _;
 use std::sync::OnceLock;
 
-use crate::render::{ReuseMis, ShiftKind};
-use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer};
+/// A family of descriptor bindings (one enum per kernel family, declared by `binding_family!`):
+/// what a binding is, without the Vulkan types that bind a buffer to it (those are
+/// `restir_pt_vk::BindingFamilyExt`, implemented for every family).
+pub trait BindingFamily: Copy {
+    /// The descriptor set of the family.
+    const SET: u32;
+    /// The GLSL block name of this binding.
+    fn block(self) -> &'static str;
+    /// The binding number in descriptor set [`BindingFamily::SET`].
+    fn binding(self) -> u32;
+}
 
 /// Declares one family of bindings of descriptor set `$set`: the enum, its GLSL macro prefix
 /// and `ALL`. Variant names are the GLSL block names.
@@ -44,20 +54,17 @@ macro_rules! binding_family {
             pub fn binding(self) -> u32 {
                 self as u32
             }
+        }
 
-            /// This binding with descriptor kind `kind`, for a kernel's layout.
-            pub fn slot(self, kind: Binding) -> BindingSlot {
-                BindingSlot {
-                    set: Self::SET,
-                    binding: self.binding(),
-                    block: self.block(),
-                    kind,
-                }
+        impl BindingFamily for $name {
+            const SET: u32 = $set;
+
+            fn block(self) -> &'static str {
+                $name::block(self)
             }
 
-            /// `buffer` bound to this binding as a storage buffer.
-            pub fn to(self, buffer: &Buffer) -> BoundBuffer<'_> {
-                self.slot(Binding::Storage).to(buffer)
+            fn binding(self) -> u32 {
+                $name::binding(self)
             }
         }
     };
@@ -135,28 +142,15 @@ binding_family! {
     /// what traversal reads; these are read only at hits. Oracle kernels that bind everything
     /// in set 0 move the family there (`SURFACE_SET`, `SURFACE_BINDING` in the GLSL).
     SurfaceBinding, "SURFACE_BINDING_", set 1 {
-        /// `TriangleSurface` per triangle (src/shading/surface.rs).
+        /// `TriangleSurface` per triangle (crates/shading-core/src/surface.rs).
         SurfaceAttributes = 0,
-        /// `MaterialTextures` per material (src/shading/texture.rs); this and the next two only with
+        /// `MaterialTextures` per material (crates/shading-core/src/texture.rs); this and the next two only with
         /// textures.
         MaterialTextureTable = 1,
         /// `TextureHeader` per texture.
         TextureHeaders = 2,
         /// RGBA8 texels.
         Texels = 3,
-    }
-}
-
-impl SurfaceBinding {
-    /// This binding moved to set `set` at `first` + its number, for oracle kernels that bind
-    /// everything in one set.
-    pub fn slot_at(self, set: u32, first: u32, kind: Binding) -> BindingSlot {
-        BindingSlot {
-            set,
-            binding: first + self.binding(),
-            block: self.block(),
-            kind,
-        }
     }
 }
 
@@ -177,6 +171,95 @@ impl RestirBinding {
     }
 }
 
+/// The shift mapping used for reuse (and, inverted, for its MIS weights). The discriminant is
+/// the value of the kernels' SHIFT_MODE ([`glsl_header`] writes the GLSL names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[repr(u32)]
+pub enum ShiftKind {
+    /// Reconnection shift: the offset path keeps its own primary hit y1 and connects it to the
+    /// base path's x2, keeping x2..xk; defined only where the base reconnects at r = 2
+    /// (docs/shift-mappings.md).
+    Reconnection = 0,
+    /// Random replay: the offset path is traced anew from y1 with the base path's random numbers;
+    /// its Jacobian is 1.
+    Replay = 1,
+    /// Hybrid shift (Lin et al. 2022; the default): random replay of y2..y_{r-1}, then a
+    /// reconnection to the base path's x_r; random replay alone where the base has no
+    /// reconnection vertex.
+    Hybrid = 2,
+}
+
+/// The resampling MIS weights of reuse (`--mis gbh|pairwise`). The discriminant is the value of
+/// the kernels' MIS_MODE.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[repr(u32)]
+pub enum ReuseMis {
+    /// Generalized balance heuristic with confidence weights, O(M^2) inverse shifts.
+    #[cfg_attr(feature = "clap", value(name = "gbh"))]
+    GeneralizedBalance = 0,
+    /// Defensive pairwise MIS, O(M).
+    Pairwise = 1,
+}
+
+impl ShiftKind {
+    /// Every shift, in discriminant order.
+    pub const ALL: [ShiftKind; 3] = [ShiftKind::Reconnection, ShiftKind::Replay, ShiftKind::Hybrid];
+
+    /// The kind called `name` (`reconnection`, `replay` or `hybrid`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// The CLI name: `reconnection`, `replay` or `hybrid`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShiftKind::Reconnection => "reconnection",
+            ShiftKind::Replay => "replay",
+            ShiftKind::Hybrid => "hybrid",
+        }
+    }
+
+    /// The GLSL macro of this kind, a value of SHIFT_MODE in glsl/restir_reuse.glsl.
+    pub fn glsl_name(self) -> &'static str {
+        match self {
+            ShiftKind::Reconnection => "SHIFT_RECONNECTION",
+            ShiftKind::Replay => "SHIFT_REPLAY",
+            ShiftKind::Hybrid => "SHIFT_HYBRID",
+        }
+    }
+}
+
+impl ReuseMis {
+    /// Every MIS, in discriminant order.
+    pub const ALL: [ReuseMis; 2] = [ReuseMis::GeneralizedBalance, ReuseMis::Pairwise];
+
+    /// The MIS called `name` (`gbh` or `pairwise`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The CLI name: `gbh` or `pairwise`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReuseMis::GeneralizedBalance => "gbh",
+            ReuseMis::Pairwise => "pairwise",
+        }
+    }
+
+    /// The GLSL macro of this MIS, a value of MIS_MODE in glsl/restir_reuse.glsl.
+    pub fn glsl_name(self) -> &'static str {
+        match self {
+            ReuseMis::GeneralizedBalance => "MIS_GBH",
+            ReuseMis::Pairwise => "MIS_PAIRWISE",
+        }
+    }
+}
+
+/// At most this many path vertices x1..xk (4 bits of length, 5 bits of lobe for each of x1..x6
+/// in `restir_pt_shading::path_record::PathRecord`).
+pub const MAX_PATH_LENGTH: usize = 7;
 /// Reservoir slots of the ReSTIR PT kernels: the previous frame's result and two that the
 /// passes of a frame alternate between (src/render/frame_plan.rs).
 pub const RESERVOIR_SLOTS: usize = 3;
@@ -232,7 +315,7 @@ fn write_family<T: Copy>(out: &mut String, prefix: &str, all: &[T], name: impl F
 
 fn build_header() -> String {
     let mut h = String::from(
-        "// Generated by src/shader_interface.rs at kernel-compile time; edit that file, not this text.\n\
+        "// Generated by crates/interface/src/shader_interface.rs at kernel-compile time; edit that file, not this text.\n\
          #ifndef SHADER_INTERFACE_GLSL\n#define SHADER_INTERFACE_GLSL\n\n",
     );
     write_family(&mut h, SceneBinding::GLSL_PREFIX, SceneBinding::ALL, |b| (b.block(), b.binding()));
@@ -259,7 +342,7 @@ fn build_header() -> String {
         ("IMAGE_LOCAL_SIZE", IMAGE_LOCAL_SIZE),
         ("COUNTER_COUNT", COUNTER_COUNT as u32),
         ("RR_START_DEPTH", RR_START_DEPTH),
-        ("MAX_PATH_LENGTH", crate::shading::path_record::MAX_PATH_LENGTH as u32),
+        ("MAX_PATH_LENGTH", MAX_PATH_LENGTH as u32),
         ("PUNCTUAL_ROWS", crate::gpu_types::PUNCTUAL_ROWS as u32),
         ("LIGHT_NODE_ROWS", crate::gpu_types::LIGHT_NODE_ROWS as u32),
         ("LIGHT_TREE_MAX_DEPTH", crate::gpu_types::LIGHT_TREE_MAX_DEPTH as u32),

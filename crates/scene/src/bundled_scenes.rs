@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+use crate::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
 /// One bundled scene: its file under scenes/ and the recipe that writes it.
 pub struct BundledScene {
@@ -55,7 +55,7 @@ pub const BUNDLED_SCENES: &[BundledScene] = &[
     },
     BundledScene {
         file_name: "many-lights.gltf",
-        build: crate::scene::many_lights_scene::many_lights,
+        build: crate::many_lights_scene::many_lights,
     },
 ];
 
@@ -142,7 +142,7 @@ pub fn cornell() -> String {
 /// filtering, repeated 5 times each way): light reaches the room through its holes and shifted
 /// paths must see the same holes. Not a bundled file; tests of alpha testing build it.
 pub fn cornell_alpha_screen(mask_png: &[u8]) -> String {
-    use crate::scene::gltf_writer::{FILTER_NEAREST, WRAP_REPEAT};
+    use crate::gltf_writer::{FILTER_NEAREST, WRAP_REPEAT};
     let mut b = GltfBuilder::default();
     cornell_room(&mut b, CORNELL_LIGHT, CORNELL_LIGHT_SIZE);
     let white = b.material("box white", MaterialSpec::diffuse(WHITE));
@@ -474,7 +474,7 @@ pub const INSTANCED_SPHERE_TRIANGLES: usize = 2 * 96 * 47;
 pub fn instanced_spheres(columns: u32, rows: u32) -> String {
     let mut b = GltfBuilder::default();
     let grey = b.material("grey", MaterialSpec::diffuse(Vec3::splat(0.6)));
-    let (mesh, normals, uv) = crate::scene::gltf_writer::textured_sphere(Vec3::ZERO, 0.45, 48, 96);
+    let (mesh, normals, uv) = crate::gltf_writer::textured_sphere(Vec3::ZERO, 0.45, 48, 96);
     let sphere = b.mesh_with_attributes("sphere", &mesh, Some(&normals), &[&uv], grey);
     let cells: Vec<Vec3> = (0..rows)
         .flat_map(|z| (0..columns).map(move |x| Vec3::new(x as f32, 0.0, z as f32)))

@@ -2,7 +2,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::gpu_types::FrameParams;
+use restir_pt_interface::gpu_types::FrameParams;
 
 /// The side of an image whose size neither the command line nor the camera sets.
 pub const DEFAULT_IMAGE_SIDE: u32 = 256;

@@ -17,11 +17,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::bvh::{trace_closest, NO_HIT};
+use restir_pt_interface::gpu_types::NO_EMITTER;
+use restir_pt_shading_core::bvh::{trace_closest, NO_HIT};
+use restir_pt_shading_core::ray_offset::offset_ray_origin;
+use restir_pt_shading_core::sampling::{build_onb, sample_cosine_hemisphere, sample_triangle, sample_uniform_sphere};
+
 use super::{luminance, PunctualKind, PunctualLight, Scene, DEFAULT_ENVIRONMENT};
-use crate::gpu_types::NO_EMITTER;
-use crate::shading::ray_offset::offset_ray_origin;
-use crate::shading::sampling::{build_onb, sample_cosine_hemisphere, sample_triangle, sample_uniform_sphere};
 
 /// Rays shot from the lights to measure how much of their emission leaves the scene.
 const ESCAPE_RAYS: u32 = 4096;

@@ -19,8 +19,9 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use glam::{Vec2, Vec3};
 
-use crate::gpu_types::Emitter;
-use crate::scene::luminance;
+use restir_pt_interface::gpu_types::Emitter;
+
+use crate::luminance;
 
 /// An equirectangular map with its sampling tables.
 #[derive(Debug, Clone, PartialEq)]
@@ -145,7 +146,7 @@ impl EnvironmentMap {
     pub fn load(path: &Path) -> Result<Self> {
         let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let (width, height, texels) = match ext.as_deref() {
-            Some("exr") => crate::image_io::read_exr(path)?,
+            Some("exr") => read_exr(path)?,
             Some("hdr") => {
                 let img = image::ImageReader::open(path)
                     .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?
@@ -230,4 +231,23 @@ impl EnvironmentMap {
             .map(|(t, &c)| Emitter::from_words([t.x.to_bits(), t.y.to_bits(), t.z.to_bits(), c.to_bits()]));
         std::iter::once(header).chain(rows).chain(texels).collect()
     }
+}
+
+/// Reads the first RGB(A) layer of an EXR: (width, height, row-major linear RGB pixels from the
+/// top left; alpha dropped).
+///
+/// # Errors
+/// The file cannot be read or holds no RGB layer; the message names `path`.
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| (resolution.width(), vec![Vec3::ZERO; resolution.width() * resolution.height()]),
+        |(w, pixels): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            pixels[pos.y() * *w + pos.x()] = Vec3::new(r, g, b)
+        },
+    )
+    .map_err(|e| anyhow!("{}: cannot read EXR: {e}", path.display()))?;
+    let size = image.layer_data.size;
+    Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
 }

@@ -4,15 +4,16 @@
 
 use anyhow::{bail, Result};
 
+use restir_pt_interface::gpu_types::Triangle;
+use restir_pt_shading_core::surface::TriangleSurface;
+
 use super::gltf_loader::{problem, Loader, MAX_NODE_DEPTH, MAX_NODE_INSTANCES};
-use crate::gpu_types::Triangle;
-use crate::shading::surface::TriangleSurface;
 
 /// The most bytes the device lets one scene array (the surface attributes or, without them, the
 /// triangles: the largest) take, and the
 /// limit's Vulkan name for messages: maxStorageBufferRange when arrays are bound,
 /// maxMemoryAllocationSize when they are reached by device address
-/// (`crate::vk::Context::scene_array_limit`).
+/// (`restir_pt::render::scene_array_limit`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ArrayLimit {
     /// The limit in bytes.

@@ -8,14 +8,15 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use glam::{DMat4, DVec3, Vec3};
 
-use super::default_environment::{light_open_scene, unlit_scene_line};
 pub use super::gltf_budget::ArrayLimit;
+use restir_pt_interface::gpu_types::{Material, Triangle};
+use restir_pt_shading_core::surface::TriangleSurface;
+use restir_pt_shading_core::texture::SceneTextures;
+
+use super::default_environment::{light_open_scene, unlit_scene_line};
 use super::gltf_json::{check_external_buffers, read_raw, Instancing};
 use super::{Camera, PunctualLight, Scene, SceneParts};
-use crate::gpu_types::{Material, Triangle};
-use crate::scene::environment::EnvironmentMap;
-use crate::shading::surface::TriangleSurface;
-use crate::shading::texture::SceneTextures;
+use crate::environment::EnvironmentMap;
 
 /// Deeper hierarchies are rejected: glTF forbids cycles, and no sane scene nests this deep.
 pub(super) const MAX_NODE_DEPTH: usize = 256;
@@ -84,10 +85,10 @@ pub struct LoadOptions {
     /// An equirectangular environment map (.exr or .hdr) that replaces the file's environment.
     pub environment_map: Option<PathBuf>,
     /// The map's rotation about +Y in degrees (`--env-rotation`; see
-    /// [`crate::scene::environment`] for the convention).
+    /// [`crate::environment`] for the convention).
     pub env_rotation: f32,
     /// No environment at all (`--env none`): neither the file's nor the default one
-    /// (crate::scene::default_environment).
+    /// (crate::default_environment).
     pub no_environment: bool,
     /// The most bytes the device lets one scene array take: a file whose accessor counts
     /// promise more triangles than that fails before its vertices are read.

@@ -5,9 +5,10 @@
 use anyhow::{bail, Result};
 use glam::Vec3;
 
+use restir_pt_interface::gpu_types::{Material, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION, MATERIAL_DOUBLE_SIDED, MATERIAL_UNLIT};
+use restir_pt_shading_core::texture::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
+
 use super::gltf_loader::{problem, Loader};
-use crate::gpu_types::{Material, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION, MATERIAL_DOUBLE_SIDED, MATERIAL_UNLIT};
-use crate::shading::texture::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
 
 /// Specular reflectance at normal incidence of dielectrics in the metallic-roughness model.
 const DIELECTRIC_F0: f32 = 0.04;
@@ -193,7 +194,10 @@ impl Loader<'_> {
                 specular_color.is_finite() && specular_color.min_element() >= 0.0,
             ),
             // Within rounding below 1 is index-matched (docs/materials.md), not an error.
-            ("ior", ior.is_finite() && (ior >= 1.0 || crate::shading::bsdf::index_matched(ior))),
+            (
+                "ior",
+                ior.is_finite() && (ior >= 1.0 || restir_pt_shading_core::bsdf::index_matched(ior)),
+            ),
         ];
         if let Some((field, _)) = checks.iter().find(|(_, ok)| !ok) {
             bail!(problem(self.path, format!("{name}: {field} is out of range or not a number")));

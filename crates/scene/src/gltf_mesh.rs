@@ -6,10 +6,11 @@ use std::collections::HashMap;
 use anyhow::{bail, Result};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 
+use restir_pt_interface::gpu_types::{Triangle, NO_EMITTER};
+use restir_pt_shading_core::surface::{pack_vertex_color, TriangleSurface};
+
 use super::gltf_json::Instancing;
 use super::gltf_loader::{problem, Loader, MAX_TRIANGLES};
-use crate::gpu_types::{Triangle, NO_EMITTER};
-use crate::shading::surface::{pack_vertex_color, TriangleSurface};
 
 /// Vertex-index triples of the triangles a primitive of `mode` draws from `indices`, in the
 /// winding glTF 2.0 defines (section 3.7.2.1): strips alternate the order of their first two

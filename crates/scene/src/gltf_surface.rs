@@ -4,8 +4,9 @@
 
 use glam::{DMat3, DMat4, Vec2, Vec3, Vec4};
 
+use restir_pt_shading_core::surface::TriangleSurface;
+
 use super::gltf_loader::Loader;
-use crate::shading::surface::TriangleSurface;
 
 /// A primitive's vertex attributes in scene space (`None`: the file has none, or unusable ones).
 pub(super) struct PrimitiveSurface {

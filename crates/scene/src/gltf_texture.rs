@@ -7,11 +7,12 @@ use std::collections::HashMap;
 
 use anyhow::{bail, Result};
 
-use super::gltf_loader::{problem, Loader};
-use crate::shading::texture::{
+use restir_pt_shading_core::texture::{
     texture_transform_rows, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, NO_TEXTURE, TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP,
     TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT,
 };
+
+use super::gltf_loader::{problem, Loader};
 
 /// Textures larger than this on a side are halved until they fit (mipmaps are not built, so
 /// larger ones would alias anyway at the resolutions rendered here).

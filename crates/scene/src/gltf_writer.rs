@@ -8,7 +8,7 @@ mod textures;
 
 pub use textures::{textured_sphere, FILTER_LINEAR, FILTER_NEAREST, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT};
 
-/// A glTF metallic-roughness material to write (the fields map to [`crate::gpu_types::Material`]'s).
+/// A glTF metallic-roughness material to write (the fields map to [`restir_pt_interface::gpu_types::Material`]'s).
 #[derive(Debug, Clone, Copy)]
 pub struct MaterialSpec {
     /// baseColorFactor (linear RGB; alpha is written as 1).

@@ -1,14 +1,15 @@
-//! What a hit on the scene sees: its surface (src/shading/surface.rs) and its material with textures
-//! applied (src/shading/texture.rs). Host counterparts of `surface_at`, `material_at` and
+//! What a hit on the scene sees: its surface (crates/shading-core/src/surface.rs) and its material with textures
+//! applied (crates/shading-core/src/texture.rs). Host counterparts of `surface_at`, `material_at` and
 //! `normal_mapped` in glsl/surface.glsl and glsl/texture.glsl.
 
 use glam::{Vec2, Vec3};
 
+use restir_pt_interface::gpu_types::Material;
+use restir_pt_shading_core::alpha::AlphaScene;
+use restir_pt_shading_core::surface::{surface_at, SurfaceHit, TriangleSurface};
+use restir_pt_shading_core::texture::{normal_mapped, textured_material, vertex_colored, ALPHA_OPAQUE, NO_TEXTURE};
+
 use super::Scene;
-use crate::gpu_types::Material;
-use crate::shading::alpha::AlphaScene;
-use crate::shading::surface::{surface_at, SurfaceHit, TriangleSurface};
-use crate::shading::texture::{normal_mapped, textured_material, vertex_colored, ALPHA_OPAQUE, NO_TEXTURE};
 
 impl Scene {
     /// What traversal needs to alpha-test hits (the kernels' `SCENE_ALPHA`); `None` when every

@@ -1,6 +1,20 @@
-//! The renderable scene: triangles in BVH order, materials, emitters, environment and cameras.
+//! restir-pt-scene, the renderable scene: triangles in BVH order, materials, emitters,
+//! environment and cameras; the glTF loader that makes one, the BVH and light-tree builds, the
+//! environment maps (with the EXR reader they need) and the bundled scenes.
+//!
+//! It may use restir-pt-interface (the records a scene is made of) and restir-pt-shading-core
+//! (the twins loading runs: the default environment traces rays from the lights, and a hit's
+//! surface, material and alpha test below are those twins'); nothing of the Vulkan layer, the
+//! scene-wide shading twins or the renderer (docs/layout.md). What a device allows a
+//! scene is decided by the renderer (`restir_pt::render::scene_array_limit`) and handed to the
+//! loader as an [`ArrayLimit`].
 
-pub mod alpha_trace;
+// Every public item carries a doc comment (units, spaces, layouts, errors, sources): a new
+// undocumented one fails the build, clippy and rustdoc alike.
+#![deny(missing_docs)]
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod bundled_scenes;
 pub mod bvh;
 mod camera;
@@ -28,17 +42,22 @@ pub use gltf_material::spec_gloss_to_metal_rough;
 pub use gltf_mesh::triangle_indices;
 pub use punctual::{PunctualKind, PunctualLight};
 
-pub use crate::metrics::luminance;
-
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
-use crate::gpu_types::{BvhNode, Emitter, LightNode, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
-use crate::scene::bvh::Bvh;
-use crate::scene::environment::EnvironmentMap;
-use crate::scene::light_tree::{LightBounds, LightTree};
-use crate::shading::surface::TriangleSurface;
-use crate::shading::texture::{SceneTextures, ALPHA_OPAQUE};
+use restir_pt_interface::gpu_types::{BvhNode, Emitter, LightNode, Material, Triangle, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use restir_pt_shading_core::surface::TriangleSurface;
+use restir_pt_shading_core::texture::{SceneTextures, ALPHA_OPAQUE};
+
+use crate::bvh::Bvh;
+use crate::environment::EnvironmentMap;
+use crate::light_tree::{LightBounds, LightTree};
+
+/// Relative luminance of linear Rec. 709 / sRGB primaries (ITU-R BT.709 weights). Light power,
+/// the light tree and environment sampling weigh by it here; `restir_pt::metrics` re-exports it.
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
 
 /// Probability that NEE samples the environment when the scene also has other lights.
 const ENV_SELECT_PROB_WITH_EMITTERS: f32 = 0.5;
@@ -51,11 +70,11 @@ pub struct Scene {
     /// Triangles in BVH leaf order, each with its material and emitter index.
     pub triangles: Vec<Triangle>,
     /// Vertex attributes of `triangles` (same order), or empty: a scene of flat faces without
-    /// textures has none (see src/shading/surface.rs).
+    /// textures has none (see crates/shading-core/src/surface.rs).
     pub surfaces: Vec<TriangleSurface>,
     /// The materials' textures (empty: none).
     pub textures: SceneTextures,
-    /// The BVH over `triangles`, in depth-first order with skip links (src/scene/bvh.rs).
+    /// The BVH over `triangles`, in depth-first order with skip links (crates/scene/src/bvh.rs).
     pub nodes: Vec<BvhNode>,
     /// Materials by index (`Triangle::material`).
     pub materials: Vec<Material>,
@@ -64,7 +83,7 @@ pub struct Scene {
     /// The lights NEE chooses from: emissive triangles, then point and spot lights (the light
     /// tree's leaves, each with its bit trail), then directional lights.
     pub emitters: Vec<Emitter>,
-    /// The light tree over the emitters before the directional ones (src/scene/light_tree.rs);
+    /// The light tree over the emitters before the directional ones (crates/scene/src/light_tree.rs);
     /// empty when there are none.
     pub light_nodes: Vec<LightNode>,
     /// Directional lights: the last rows of `emitters`, outside the light tree: NEE takes each
@@ -258,13 +277,13 @@ impl Scene {
         }
     }
 
-    /// The emitter-buffer rows of the punctual lights (see `gpu_types::punctual_rows`).
+    /// The emitter-buffer rows of the punctual lights (see `punctual::punctual_rows`).
     pub fn punctual_rows(&self) -> Vec<Emitter> {
-        crate::gpu_types::punctual_rows(&self.lights, &self.punctual_emitter_rows)
+        punctual::punctual_rows(&self.lights, &self.punctual_emitter_rows)
     }
 
     /// The emitter-buffer rows of the light tree (glsl/light_tree.glsl): a header (directional
-    /// lights, nodes, 0, 0), then [`crate::gpu_types::LIGHT_NODE_ROWS`] rows per node.
+    /// lights, nodes, 0, 0), then [`restir_pt_interface::gpu_types::LIGHT_NODE_ROWS`] rows per node.
     pub fn light_tree_rows(&self) -> Vec<Emitter> {
         let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, 0, 0]);
         std::iter::once(header)

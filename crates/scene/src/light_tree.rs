@@ -3,11 +3,11 @@
 //! shading point rather than by its power alone (pbrt-v4 `BVHLightSampler`; Conty Estevez and
 //! Kulla, "Importance Sampling of Many Lights with Adaptive Tree Splitting", 2018). Built here on
 //! the host, flattened depth first into [`LightNode`]s; glsl/light_tree.glsl and its twin
-//! src/shading/light_tree.rs walk it.
+//! crates/shading/src/light_tree.rs walk it.
 
 use glam::{Quat, Vec3};
 
-use crate::gpu_types::{LightNode, LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED, LIGHT_TREE_MAX_DEPTH};
+use restir_pt_interface::gpu_types::{LightNode, LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED, LIGHT_TREE_MAX_DEPTH};
 
 /// The spatial and directional bounds of one light or a group of lights (pbrt-v4 `LightBounds`).
 /// Directions are unit vectors in scene coordinates; `intensity` is luminance in W/sr.

@@ -4,7 +4,7 @@
 use glam::Vec3;
 use serde_json::json;
 
-use crate::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
+use crate::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
 /// Lamps along each side of the grid (LAMP_GRID² in all: one in five, on diagonals, a point
 /// light, the rest emissive panels).

@@ -4,6 +4,8 @@
 use anyhow::{bail, Result};
 use glam::{DMat4, DVec3, Vec3};
 
+use restir_pt_interface::gpu_types::Emitter;
+
 use super::gltf_loader::{problem, Loader};
 use super::luminance;
 
@@ -109,4 +111,22 @@ impl Loader<'_> {
         }
         Ok(())
     }
+}
+
+/// The emitter-buffer rows of punctual lights (`emitter_rows[k]`: the row of light k among the
+/// [`Emitter`]s), reinterpreting each 16-byte row as four 32-bit words.
+pub(crate) fn punctual_rows(lights: &[PunctualLight], emitter_rows: &[u32]) -> Vec<Emitter> {
+    let row = |a: [f32; 3], w: u32| Emitter::from_words([a[0].to_bits(), a[1].to_bits(), a[2].to_bits(), w]);
+    lights
+        .iter()
+        .zip(emitter_rows)
+        .flat_map(|(l, &r)| {
+            [
+                row(l.position.into(), l.kind as u32),
+                row(l.direction.into(), l.cos_outer.to_bits()),
+                row(l.intensity.into(), l.cos_inner.to_bits()),
+                Emitter::from_words([r, 0, 0, 0]),
+            ]
+        })
+        .collect()
 }

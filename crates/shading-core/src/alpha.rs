@@ -5,14 +5,15 @@
 
 use glam::{UVec4, Vec2, Vec3};
 
-use crate::gpu_types::Triangle;
-use crate::shading::rng::{pcg4d, u32_to_unit_float};
-use crate::shading::surface::{surface_at, TriangleSurface};
-use crate::shading::texture::{material_alpha, SceneTextures, ALPHA_MASK, ALPHA_OPAQUE};
+use restir_pt_interface::gpu_types::Triangle;
+
+use crate::rng::{pcg4d, u32_to_unit_float};
+use crate::surface::{surface_at, TriangleSurface};
+use crate::texture::{material_alpha, SceneTextures, ALPHA_MASK, ALPHA_OPAQUE};
 
 /// What traversal needs to alpha-test a hit: the triangles' surface attributes (for texture
 /// coordinates, same order as the triangles) and the material texture table. A scene has one
-/// only when some material is not opaque ([`crate::scene::Scene::alpha`]); kernels are then
+/// only when some material is not opaque (`restir_pt_scene::Scene::alpha`); kernels are then
 /// compiled with `SCENE_ALPHA`.
 #[derive(Clone, Copy)]
 pub struct AlphaScene<'a> {

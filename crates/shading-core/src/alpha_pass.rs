@@ -10,9 +10,10 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::gpu_types::Triangle;
-use crate::scene::bvh::{Hit, NO_HIT};
-use crate::shading::alpha::{alpha_keeps, AlphaScene};
+use restir_pt_interface::gpu_types::Triangle;
+
+use crate::alpha::{alpha_keeps, AlphaScene};
+use crate::bvh::{Hit, NO_HIT};
 
 /// One ray's candidates over a traversal pass (GLSL `AlphaPass`).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,15 +1,16 @@
 //! Traversal of scenes with alpha-tested materials, the twins of glsl/alpha_trace.glsl
 //! (`bvh_traverse`, `bvh_alpha_pass`) and glsl/alpha_trace_pair.glsl (`trace_pair`,
 //! `trace_pair_alpha_pass`): the loops record candidate hits and the alpha tests run after them
-//! ([`crate::shading::alpha_pass`]). [`crate::scene::bvh::bvh_traverse`] and
-//! [`crate::scene::bvh::trace_pair`] call these when given an [`AlphaScene`].
+//! ([`crate::alpha_pass`]). [`crate::bvh::bvh_traverse`] and
+//! [`crate::bvh::trace_pair`] call these when given an [`AlphaScene`].
 
 use glam::Vec3;
 
-use crate::gpu_types::{BvhNode, Triangle};
-use crate::scene::bvh::{intersect_aabb, intersect_triangle, safe_inverse, Hit, PairRay, NO_HIT};
-use crate::shading::alpha::AlphaScene;
-use crate::shading::alpha_pass::{alpha_pass_begin, alpha_pass_new, alpha_pass_record, alpha_pass_resolve, AlphaPass};
+use restir_pt_interface::gpu_types::{BvhNode, Triangle};
+
+use crate::alpha::AlphaScene;
+use crate::alpha_pass::{alpha_pass_begin, alpha_pass_new, alpha_pass_record, alpha_pass_resolve, AlphaPass};
+use crate::bvh::{intersect_aabb, intersect_triangle, safe_inverse, Hit, PairRay, NO_HIT};
 
 /// One pass of the ray (o, d) over the BVH, boxes culled at the nearest opaque hit so far (so
 /// every alpha-tested hit before it is met); with `any_hit` the pass ends at an opaque hit.

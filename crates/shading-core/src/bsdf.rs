@@ -5,8 +5,9 @@
 use glam::{Vec3, Vec4};
 use std::f32::consts::PI;
 
-use crate::gpu_types::Material;
-use crate::shading::sampling::{build_onb, pdf_cosine_hemisphere, sample_cosine_hemisphere, sample_ggx_vndf, to_local, to_world, INV_PI};
+use restir_pt_interface::gpu_types::Material;
+
+use crate::sampling::{build_onb, pdf_cosine_hemisphere, sample_cosine_hemisphere, sample_ggx_vndf, to_local, to_world, INV_PI};
 
 /// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes
 /// are ill-conditioned in f32 (pdf errors grow like epsilon / alpha).

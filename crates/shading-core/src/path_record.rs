@@ -9,8 +9,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-/// At most this many vertices x1..xk (4 bits of length, 5 bits of lobe for each of x1..x6).
-pub const MAX_PATH_LENGTH: usize = 7;
+pub use restir_pt_interface::shader_interface::MAX_PATH_LENGTH;
 const LOBE_BITS: u32 = 5;
 const INFO_LENGTH_MASK: u32 = 0xf;
 const INFO_RC_SHIFT: u32 = 4;
@@ -18,13 +17,13 @@ const INFO_NEE_END: u32 = 1 << 8;
 const INFO_DIRECTIONAL_SHIFT: u32 = 9;
 
 /// A reservoir's path sample (glsl/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
-/// GPU split into [`crate::gpu_types::ReservoirHead`] and [`crate::gpu_types::ReservoirTail`]).
+/// GPU split into [`restir_pt_interface::gpu_types::ReservoirHead`] and [`restir_pt_interface::gpu_types::ReservoirTail`]).
 /// x_0 is the camera, x_1..x_k the path's vertices, x_r the reconnection vertex; positions and
 /// directions are in scene coordinates, colours linear RGB.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct PathRecord {
-    /// The path's random-number key ([`crate::shading::rng::path_seed`]): random replay
+    /// The path's random-number key ([`crate::rng::path_seed`]): random replay
     /// regenerates the path from it.
     pub seed: u32,
     /// Bits 0-3: the length k; bits 4-7: the reconnection index r (0: none); bit 8: NEE end;

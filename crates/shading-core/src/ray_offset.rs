@@ -17,11 +17,11 @@
 //! the plane so that the offset survives rounding. The bound scales with the coordinates and the
 //! triangle's size, never with a fixed floor, so a scene behaves the same at any scale; far from
 //! the origin f32 coordinates themselves lose the geometry, which is why the loader re-centres
-//! scenes on their first camera (src/scene/gltf_loader.rs).
+//! scenes on their first camera (crates/scene/src/gltf_loader.rs).
 
 use glam::Vec3;
 
-use crate::gpu_types::Triangle;
+use restir_pt_interface::gpu_types::Triangle;
 
 /// 2⁻¹⁷: the offset per unit of |v0| + |e1| + |e2| (see the module documentation).
 pub const RAY_OFFSET_SCALE: f32 = 1.0 / 131072.0;

@@ -10,8 +10,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::gpu_types::Triangle;
-use crate::shading::sampling::build_onb;
+use restir_pt_interface::gpu_types::Triangle;
+
+use crate::sampling::build_onb;
 
 /// The attributes of one triangle's three vertices (v0, v0 + e1, v0 + e2), in scene space
 /// (the triangles' coordinates), std430 layout of `TriangleSurface` in glsl/surface.glsl.

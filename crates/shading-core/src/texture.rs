@@ -7,8 +7,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::gpu_types::{Material, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION};
-use crate::shading::surface::SurfaceHit;
+use restir_pt_interface::gpu_types::{Material, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION};
+
+use crate::surface::SurfaceHit;
 
 /// [`TextureSlot::texture_index`] of a slot without a texture: the factor applies alone.
 pub const NO_TEXTURE: u32 = u32::MAX;
@@ -23,7 +24,7 @@ pub const TEXTURE_WRAP_MIRROR: u32 = 2;
 pub const TEXTURE_NEAREST: u32 = 16;
 /// [`MaterialTextures::alpha_mode`]: glTF `OPAQUE`, alpha ignored.
 pub const ALPHA_OPAQUE: u32 = 0;
-/// glTF `MASK`: a hit whose alpha is below `alpha_cutoff` is no hit ([`crate::shading::alpha`]).
+/// glTF `MASK`: a hit whose alpha is below `alpha_cutoff` is no hit ([`crate::alpha`]).
 pub const ALPHA_MASK: u32 = 1;
 /// glTF `BLEND`, rendered as stochastic transparency: a hit is kept with probability alpha.
 pub const ALPHA_BLEND: u32 = 2;
@@ -249,11 +250,11 @@ pub fn emission_coverage(m: &Material, t: &MaterialTextures, textures: &SceneTex
 
 /// `m` with the vertex colour of `s` applied: COLOR_0 multiplies the base colour (glTF 2.0
 /// section 3.9.2), and the emission of a `KHR_materials_unlit` material, which is its base colour
-/// ([`crate::gpu_types::MATERIAL_UNLIT`]). Twin of GLSL `vertex_colored`.
+/// ([`restir_pt_interface::gpu_types::MATERIAL_UNLIT`]). Twin of GLSL `vertex_colored`.
 pub fn vertex_colored(m: &Material, s: &SurfaceHit) -> Material {
     let mut out = *m;
     out.base_color = (Vec3::from(m.base_color) * s.color).into();
-    if m.flags & crate::gpu_types::MATERIAL_UNLIT != 0 {
+    if m.flags & restir_pt_interface::gpu_types::MATERIAL_UNLIT != 0 {
         out.emission = (Vec3::from(m.emission) * s.color).into();
     }
     out

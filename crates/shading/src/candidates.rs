@@ -6,15 +6,16 @@
 
 use glam::Vec3;
 
-use crate::gpu_types::Material;
-use crate::scene::Scene;
-use crate::shader_interface::{RR_MAX_SURVIVAL, RR_START_DEPTH};
-use crate::shading::bsdf::{bsdf_eval_pdf, LOBE_DELTA, LOBE_NONE};
-use crate::shading::gris::{resampler_offer, target_function, Resampler};
-use crate::shading::path_record::PathRecord;
-use crate::shading::rng::{rng_uniform4, STREAM_DIRECTIONAL, STREAM_RESAMPLE};
-use crate::shading::sampling::balance_heuristic;
-use crate::shading::shift::{
+use restir_pt_interface::gpu_types::Material;
+use restir_pt_interface::shader_interface::{RR_MAX_SURVIVAL, RR_START_DEPTH};
+use restir_pt_scene::Scene;
+
+use crate::bsdf::{bsdf_eval_pdf, LOBE_DELTA, LOBE_NONE};
+use crate::gris::{resampler_offer, target_function, Resampler};
+use crate::path_record::PathRecord;
+use crate::rng::{rng_uniform4, STREAM_DIRECTIONAL, STREAM_RESAMPLE};
+use crate::sampling::balance_heuristic;
+use crate::shift::{
     bsdf_vertex, end_emission, end_mis_weight, nee_vertex, record_path, vertex_is_escaped, vertex_is_punctual, vertex_shading, visible,
     Path, ShiftParams, Vertex,
 };

@@ -1,11 +1,11 @@
 //! Light selection by likely contribution at the shading point: the descent of the light tree
-//! (src/scene/light_tree.rs builds it) and the probability of its choice. Twin of
+//! (crates/scene/src/light_tree.rs builds it) and the probability of its choice. Twin of
 //! glsl/light_tree.glsl; each function is named as in GLSL.
 
 use glam::Vec3;
 
-use crate::gpu_types::{LightNode, LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED, LIGHT_TREE_MAX_DEPTH, NO_EMITTER};
-use crate::scene::Scene;
+use restir_pt_interface::gpu_types::{LightNode, LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED, LIGHT_TREE_MAX_DEPTH, NO_EMITTER};
+use restir_pt_scene::Scene;
 
 /// pbrt-v4 `LightBounds::Importance`: intensity · cos θ' · |cos θ_i'| / d² for a node seen from
 /// `p` with unit `normal`, θ' the smallest angle between the node's emission cone and the

@@ -1,5 +1,5 @@
 //! Next-event estimation: the twin of glsl/lights.glsl. Lights are chosen by their likely
-//! contribution at the shading point (the light tree, src/shading/light_tree.rs); point and spot
+//! contribution at the shading point (the light tree, crates/shading/src/light_tree.rs); point and spot
 //! lights (KHR_lights_punctual) are chosen beside emissive triangles, and directional lights are
 //! not chosen but taken at every vertex ([`sample_directional`]). A sample of a punctual light
 //! is a delta: its `pdf` is the discrete probability of choosing the light (1 for a directional
@@ -7,10 +7,11 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
-use crate::scene::{PunctualKind, PunctualLight, Scene};
-use crate::shading::light_tree::{directional_row, light_select, light_select_pmf};
-use crate::shading::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
+use restir_pt_interface::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use restir_pt_scene::{PunctualKind, PunctualLight, Scene};
+
+use crate::light_tree::{directional_row, light_select, light_select_pmf};
+use crate::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
 /// A next-event-estimation sample from a shading point (twin of GLSL `LightSample`,
 /// glsl/lights.glsl). A failed sample has zero `pdf` and `radiance`.
@@ -70,8 +71,8 @@ pub fn punctual_arrival(light: &PunctualLight, p: Vec3) -> (Vec3, f32, Vec3) {
 /// to a punctual light along the unit `dir` at distance `dist` (infinite: a directional light);
 /// only x is offset, the light being a point in the air. Twin of GLSL `punctual_occluded` (glsl/punctual.glsl).
 pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, tri: u32, dir: Vec3, dist: f32) -> bool {
-    use crate::scene::bvh::{trace_occluded, SEGMENT_EPSILON};
-    let origin = crate::shading::ray_offset::offset_ray_origin(x, if dir.dot(n) > 0.0 { n } else { -n }, &scene.triangles[tri as usize]);
+    use restir_pt_shading_core::bvh::{trace_occluded, SEGMENT_EPSILON};
+    let origin = crate::ray_offset::offset_ray_origin(x, if dir.dot(n) > 0.0 { n } else { -n }, &scene.triangles[tri as usize]);
     if dist.is_infinite() {
         return trace_occluded(&scene.nodes, &scene.triangles, origin, dir, 1e30);
     }

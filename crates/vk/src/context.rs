@@ -218,22 +218,6 @@ impl Context {
         self.pipelines.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
-    /// The most bytes one scene array may take: a buffer reached by device address where the
-    /// device has bufferDeviceAddress, else one storage binding.
-    pub fn scene_array_limit(&self) -> crate::scene::ArrayLimit {
-        if self.info.buffer_device_address {
-            crate::scene::ArrayLimit {
-                bytes: self.info.max_allocation_bytes,
-                name: "maxMemoryAllocationSize",
-            }
-        } else {
-            crate::scene::ArrayLimit {
-                bytes: self.info.max_storage_buffer_range,
-                name: "maxStorageBufferRange",
-            }
-        }
-    }
-
     /// Checks a storage binding against maxStorageBufferRange before anything is allocated.
     pub fn check_binding_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
         if bytes > self.info.max_storage_buffer_range {

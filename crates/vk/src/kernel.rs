@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use ash::vk;
+use restir_pt_interface::shader_interface::BindingFamily;
 
 use super::reflect::check_bindings;
 use super::shader::{compile_timed, process_cpu_ms, CompiledKernel};
@@ -22,7 +23,8 @@ pub enum Binding {
 }
 
 /// One binding of a kernel: its descriptor set and number, the GLSL block declared there and
-/// its descriptor kind. src/shader_interface.rs declares those of the renderers' kernels.
+/// its descriptor kind. crates/interface/src/shader_interface.rs declares those of the renderers'
+/// kernels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BindingSlot {
     /// Descriptor set number.
@@ -51,6 +53,40 @@ impl BindingSlot {
         BoundBuffer { slot: self, buffer }
     }
 }
+
+/// The Vulkan side of a binding family of restir-pt-interface: its bindings as [`BindingSlot`]s
+/// and buffers bound to them. Implemented for every [`BindingFamily`], so that `use` of this
+/// trait gives `SceneBinding::Triangles.slot(kind)` and `RestirBinding::Accum.to(&buffer)`.
+pub trait BindingFamilyExt: BindingFamily {
+    /// This binding with descriptor kind `kind`, for a kernel's layout.
+    fn slot(self, kind: Binding) -> BindingSlot {
+        BindingSlot {
+            set: Self::SET,
+            binding: self.binding(),
+            block: self.block(),
+            kind,
+        }
+    }
+
+    /// `buffer` bound to this binding as a storage buffer.
+    fn to(self, buffer: &Buffer) -> BoundBuffer<'_> {
+        self.slot(Binding::Storage).to(buffer)
+    }
+
+    /// This binding moved to set `set` at `first` + its number, for oracle kernels that bind
+    /// everything in one set (the surface family, `SURFACE_SET` and `SURFACE_BINDING` in the
+    /// GLSL).
+    fn slot_at(self, set: u32, first: u32, kind: Binding) -> BindingSlot {
+        BindingSlot {
+            set,
+            binding: first + self.binding(),
+            block: self.block(),
+            kind,
+        }
+    }
+}
+
+impl<F: BindingFamily> BindingFamilyExt for F {}
 
 /// A buffer for the binding `slot` (checked against the kernel's layout by `Kernel::bind`).
 #[derive(Clone, Copy)]

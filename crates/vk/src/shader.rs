@@ -8,13 +8,14 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 
+use restir_pt_interface::shader_interface::{glsl_header, GLSL_HEADER_NAME};
+
 use super::spirv_cache;
-use crate::shader_interface::{glsl_header, GLSL_HEADER_NAME};
 
 /// Every file under glsl/, keyed by its path relative to glsl/.
 pub static GLSL_SOURCES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/glsl_sources.rs"));
 
-/// The text of glsl/`name`, or of the header generated from src/shader_interface.rs when
+/// The text of glsl/`name`, or of the header generated from crates/interface/src/shader_interface.rs when
 /// `name` is its include name.
 pub fn glsl_source(name: &str) -> Option<&'static str> {
     if name == GLSL_HEADER_NAME {

@@ -4,7 +4,7 @@
 //!
 //! An entry is `<key>.spv` in the cache folder, the key a SHA-256 over everything that decides the
 //! SPIR-V: every embedded GLSL source and the generated interface header (any of them may be
-//! included), the kernel's name, its defines in order, and the text of src/vk/shader.rs, which
+//! included), the kernel's name, its defines in order, and the text of crates/vk/src/shader.rs, which
 //! sets the compile options. A change to any of them is a new key, so entries never go stale; old
 //! ones are only left behind. A cache that cannot be read or written is passed over: the kernel
 //! is compiled as without it.
@@ -14,8 +14,9 @@ use std::sync::OnceLock;
 
 use sha2::{Digest, Sha256};
 
+use restir_pt_interface::shader_interface::glsl_header;
+
 use super::shader::GLSL_SOURCES;
-use crate::shader_interface::glsl_header;
 
 /// The environment variable that names the cache folder; the value `off` turns the cache off.
 pub const SPIRV_CACHE_ENV: &str = "RESTIR_PT_SPIRV_CACHE";

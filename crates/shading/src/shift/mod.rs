@@ -2,7 +2,7 @@
 //! glsl/shift.glsl is to mirror, file by file: `vertex.rs` (glsl/shift_vertex.glsl), `path.rs`
 //! (shift_path.glsl), `reconnection.rs` (shift_reconnection.glsl) and the shifts here
 //! (shift.glsl). A path is regenerated from its primary hit and its seed (the counter-based RNG
-//! of src/shading/rng.rs), so random replay needs nothing else; reconnection and hybrid keep the
+//! of crates/shading-core/src/rng.rs), so random replay needs nothing else; reconnection and hybrid keep the
 //! base path's suffix from the reconnection vertex x_r on.
 //!
 //! Contribution f(X) of a path x0 (camera), x1 (primary hit), ..., xk: the product over the
@@ -33,10 +33,11 @@ pub use path::*;
 pub use reconnection::*;
 pub use vertex::*;
 
-use crate::scene::Scene;
-use crate::shading::path_record::{record_length, record_nee_directional, record_nee_end, record_reconnection_index, PathRecord};
 use path::{shift_failed, shift_ok};
 use reconnection::reconnect_at;
+use restir_pt_scene::Scene;
+
+use crate::path_record::{record_length, record_nee_directional, record_nee_end, record_reconnection_index, PathRecord};
 
 /// Random replay: regenerate the record's random numbers from the target's primary hit. Valid
 /// only with the same length, end type (and NEE technique) and lobes at every vertex; Jacobian 1.

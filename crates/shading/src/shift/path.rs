@@ -4,25 +4,26 @@
 
 use glam::Vec3;
 
+use restir_pt_interface::gpu_types::{Material, NO_EMITTER};
+use restir_pt_scene::Scene;
+use restir_pt_shading_core::bvh::{trace_closest, NO_HIT};
+
 use super::reconnection::ReconnectionTerms;
 use super::vertex::{
     end_emission, end_mis_weight, hit_vertex, is_reconnectable, vertex_escaped, vertex_is_escaped, vertex_on_surface, vertex_punctual,
     vertex_shading, visible, ShiftParams, Vertex,
 };
-use crate::gpu_types::{Material, NO_EMITTER};
-use crate::scene::bvh::{trace_closest, NO_HIT};
-use crate::scene::Scene;
-use crate::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, BsdfSample, LOBE_DELTA, LOBE_NONE};
-use crate::shading::lights::{is_punctual_light, sample_directional, sample_light, LightSample};
-use crate::shading::path_record::PathRecord;
-use crate::shading::ray_offset::offset_ray_origin;
-use crate::shading::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
+use crate::bsdf::{bsdf_eval_pdf, bsdf_sample, BsdfSample, LOBE_DELTA, LOBE_NONE};
+use crate::lights::{is_punctual_light, sample_directional, sample_light, LightSample};
+use crate::path_record::PathRecord;
+use crate::ray_offset::offset_ray_origin;
+use crate::rng::{rng_uniform4, STREAM_BSDF, STREAM_LIGHT};
 
 /// A path x1..xk from a camera position, with what regenerating it needs (seed, end type) and
 /// what sampling it produced (lobes, pdfs, per-vertex weights).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Path {
-    /// The path's random-number key ([`crate::shading::rng::path_seed`]).
+    /// The path's random-number key ([`crate::rng::path_seed`]).
     pub seed: u32,
     /// The camera position x0, scene coordinates.
     pub camera: Vec3,

@@ -4,16 +4,17 @@
 
 use glam::Vec3;
 
+use restir_pt_scene::Scene;
+use restir_pt_shading_core::bvh::NO_HIT;
+
 use super::path::{reconnection_index, shift_failed, shift_ok, trace_vertices, Path, ShiftResult};
 use super::vertex::{
     direction, end_emission, end_mis_weight, is_reconnectable, light_pdf, vertex_escaped, vertex_is_escaped, vertex_is_punctual,
     vertex_on_surface, vertex_punctual, vertex_shading, visible, ShiftParams, Vertex,
 };
-use crate::scene::bvh::NO_HIT;
-use crate::scene::Scene;
-use crate::shading::bsdf::{bsdf_eval_pdf, LOBE_DELTA};
-use crate::shading::lights::is_punctual_light;
-use crate::shading::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord, MAX_PATH_LENGTH};
+use crate::bsdf::{bsdf_eval_pdf, LOBE_DELTA};
+use crate::lights::is_punctual_light;
+use crate::path_record::{record_length, record_lobe, record_nee_end, record_reconnection_index, PathRecord, MAX_PATH_LENGTH};
 
 /// The record of `path`: its reconnection index and the base-side Jacobian terms there, the
 /// suffix's radiance and the contribution. `None` if the path is longer than a record holds, or

@@ -4,19 +4,20 @@
 
 use glam::Vec3;
 
-use crate::gpu_types::{Material, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
-use crate::scene::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
-use crate::scene::PunctualKind;
-use crate::scene::Scene;
-use crate::shading::bsdf::{bsdf_eval_pdf, has_specular_layer, index_matched, lobe_weights, DELTA_ALPHA};
-use crate::shading::light_tree::light_select_pmf;
-use crate::shading::lights::{
+use restir_pt_interface::gpu_types::{Material, NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use restir_pt_scene::PunctualKind;
+use restir_pt_scene::Scene;
+use restir_pt_shading_core::bvh::{segment_occluded, trace_closest, trace_occluded, NO_HIT};
+
+use crate::bsdf::{bsdf_eval_pdf, has_specular_layer, index_matched, lobe_weights, DELTA_ALPHA};
+use crate::light_tree::light_select_pmf;
+use crate::lights::{
     emitted_radiance, emitter_area_pdf, environment_pdf, environment_radiance, is_punctual_light, punctual_arrival, punctual_emitter_row,
     punctual_occluded,
 };
-use crate::shading::ray_offset::offset_ray_origin;
-use crate::shading::sampling::balance_heuristic;
-use crate::shading::surface::triangle_bary;
+use crate::ray_offset::offset_ray_origin;
+use crate::sampling::balance_heuristic;
+use crate::surface::triangle_bary;
 
 /// Roughness below which a vertex cannot be a reconnection endpoint (the public reference's 0.2).
 pub const DEFAULT_ROUGHNESS_THRESHOLD: f32 = 0.2;
@@ -25,7 +26,7 @@ pub const DEFAULT_DISTANCE_FRACTION: f32 = 0.03;
 
 /// The reconnection criteria of the shifts (Lin et al. 2022: a vertex is reconnectable when it
 /// and its predecessor are rough and far enough apart). Twin of GLSL `ShiftParams`
-/// (glsl/shift_vertex.glsl); the kernels read it from [`crate::gpu_types::ReuseParams`].
+/// (glsl/shift_vertex.glsl); the kernels read it from [`restir_pt_interface::gpu_types::ReuseParams`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShiftParams {
     /// Perceptual roughness below which a GGX lobe counts as glossy: such a vertex cannot be a
@@ -239,7 +240,7 @@ pub fn end_mis_weight(scene: &Scene, x: &Vertex, before: Vec3, end: &Vertex, nee
     }
 }
 
-pub(super) fn hit_vertex(scene: &Scene, hit: crate::scene::bvh::Hit) -> Vertex {
+pub(super) fn hit_vertex(scene: &Scene, hit: restir_pt_shading_core::bvh::Hit) -> Vertex {
     let t = &scene.triangles[hit.triangle as usize];
     vertex_on_surface(
         scene,
