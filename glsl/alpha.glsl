@@ -2,7 +2,7 @@
 // no hit) and BLEND as stochastic transparency (a hit is kept with probability alpha), for
 // closest-hit and shadow rays alike. Only kernels of a scene with such a material define
 // SCENE_ALPHA and include this file, so opaque scenes compile to the same code as without it.
-// Expects the scene and surface bindings. Twin: src/shading/alpha.rs (docs/materials.md,
+// Expects the scene and surface bindings. Twin: crates/shading-core/src/alpha.rs (docs/materials.md,
 // "Alpha modes").
 #ifndef ALPHA_GLSL
 #define ALPHA_GLSL

@@ -7,7 +7,7 @@
 // through another pass, counting only hits past the rejected one in (t, triangle index) order,
 // the order in which both traversals visit triangles (the BVH's leaves index them in depth-first
 // order). The hit found is the one a test inside the loop finds: the first of the nearest kept
-// hits. Twin: AlphaPass in src/shading/alpha_pass.rs.
+// hits. Twin: AlphaPass in crates/shading-core/src/alpha_pass.rs.
 #ifndef ALPHA_PASS_GLSL
 #define ALPHA_PASS_GLSL
 

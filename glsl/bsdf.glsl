@@ -2,7 +2,7 @@
 // specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric. All
 // directions point away from the surface. BSDFs evaluate in the shading frame (normal ns); the
 // geometric normal ng (as wound) decides sides (docs/materials.md, "Shading normals").
-// Twin: src/shading/bsdf.rs.
+// Twin: crates/shading-core/src/bsdf.rs.
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
 

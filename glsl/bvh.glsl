@@ -1,5 +1,5 @@
 // Ray-triangle intersection and stack traversal of the flattened BVH. Expects the scene buffers
-// `triangles` and `nodes` (scene_bindings.glsl). Twin: src/scene/bvh.rs.
+// `triangles` and `nodes` (scene_bindings.glsl). Twin: crates/shading-core/src/bvh.rs.
 #ifndef BVH_GLSL
 #define BVH_GLSL
 

@@ -1,4 +1,4 @@
-// Pinhole camera rays from the frame parameters. Twin: Camera::ray_dir in src/scene/camera.rs.
+// Pinhole camera rays from the frame parameters. Twin: Camera::ray_dir in crates/scene/src/camera.rs.
 #ifndef CAMERA_GLSL
 #define CAMERA_GLSL
 

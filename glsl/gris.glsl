@@ -1,6 +1,6 @@
 // Resampling MIS weights of generalized RIS (docs/restir.md): the generalized balance heuristic
 // m_i(y) = c_i p̂_{<-i}(y) / sum_j c_j p̂_{<-j}(y) and defensive pairwise MIS, over the inputs of
-// one resampling. Twin: src/shading/gris.rs (mis_weight); MIS_MODE selects the weight at compile time.
+// one resampling. Twin: crates/shading-core/src/gris.rs (mis_weight); MIS_MODE selects the weight at compile time.
 // Needs nothing but the loop budget and the shader interface's limits, so that an oracle kernel can include it alone.
 #ifndef GRIS_GLSL
 #define GRIS_GLSL

@@ -1,9 +1,9 @@
 // Light selection by likely contribution: a stochastic single-path descent of the light tree
-// (pbrt-v4 BVHLightSampler; Conty Estevez & Kulla 2018), built on the host (src/scene/light_tree.rs)
+// (pbrt-v4 BVHLightSampler; Conty Estevez & Kulla 2018), built on the host (crates/scene/src/light_tree.rs)
 // and stored in the emitter buffer right after the emitter rows: a header row (directional light
 // count, node count, 0, 0), then LIGHT_NODE_ROWS rows per node.
 // Directional lights are not in the tree: NEE takes each of them (light_select_pmf). Expects `emitters` and the
-// scene parameters (scene_bindings.glsl). Twin: src/shading/light_tree.rs.
+// scene parameters (scene_bindings.glsl). Twin: crates/shading/src/light_tree.rs.
 #ifndef LIGHT_TREE_GLSL
 #define LIGHT_TREE_GLSL
 

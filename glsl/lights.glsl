@@ -4,7 +4,7 @@
 // besides, at every vertex (sample_directional). A punctual light's sample is a delta: pdf is
 // the discrete probability of choosing it (1 for a directional light), radiance is
 // I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
-// `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: src/shading/lights.rs.
+// `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: crates/shading/src/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
 
@@ -28,7 +28,7 @@
 #ifndef SCENE_DIRECTIONAL
 #define SCENE_DIRECTIONAL 1
 #endif
-// An equirectangular environment map (src/scene/environment.rs) replaces the constant environment; its
+// An equirectangular environment map (crates/scene/src/environment.rs) replaces the constant environment; its
 // rows start SCENE_ENV_MAP_BASE rows after the emitter rows in the emitter buffer (after the light
 // tree and the punctual lights).
 #ifndef SCENE_ENV_MAP
@@ -211,7 +211,7 @@ float environment_pdf(vec3 dir) {
 }
 
 // A direction to the environment from u in [0, 1)^2 (by luminance for a map). Twin:
-// Environment::sample_environment (src/scene/environment.rs) for a map.
+// Environment::sample_environment (crates/scene/src/environment.rs) for a map.
 vec3 sample_environment(vec2 u) {
 #if SCENE_ENV_MAP
     uvec2 size = env_size();

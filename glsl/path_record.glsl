@@ -1,4 +1,4 @@
-// The path sample a reservoir stores (80 bytes). Twin: src/shading/path_record.rs.
+// The path sample a reservoir stores (80 bytes). Twin: crates/shading-core/src/path_record.rs.
 #ifndef PATH_RECORD_GLSL
 #define PATH_RECORD_GLSL
 

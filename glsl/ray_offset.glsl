@@ -1,11 +1,11 @@
 // Error-bounded ray origins: every ray that leaves a surface starts at offset_ray_origin.
-// Twin: src/shading/ray_offset.rs, where the bound is derived.
+// Twin: crates/shading-core/src/ray_offset.rs, where the bound is derived.
 #ifndef RAY_OFFSET_GLSL
 #define RAY_OFFSET_GLSL
 
 #include "types.glsl"
 
-// 2^-17 = 128 unit roundoffs of f32 per unit of |v0| + |e1| + |e2| (see src/shading/ray_offset.rs).
+// 2^-17 = 128 unit roundoffs of f32 per unit of |v0| + |e1| + |e2| (see crates/shading-core/src/ray_offset.rs).
 const float RAY_OFFSET_SCALE = 1.0 / 131072.0;
 
 // The float next to x away from zero in direction s (s > 0: up, s < 0: down); x itself when

@@ -1,7 +1,7 @@
 // The reuse loop of GRIS (docs/restir.md): inputs from other domains are shifted into the
 // canonical domain, weighted by resampling MIS weights (gris.glsl) computed with inverse shifts,
 // and one is chosen by the streaming resampler (reservoir.glsl). Twin: resample_inputs in
-// src/shading/resample_inputs.rs, whose test runs both on the toy domains of the GRIS tests.
+// crates/shading/src/resample_inputs.rs, whose test runs both on the toy domains of the GRIS tests.
 //
 // It runs on a bridge the including file defines first, as RTXDI's resampling functions run on
 // its RAB_* functions: the renderer's (restir_reuse.glsl) on pixels, frames and path shifts, the

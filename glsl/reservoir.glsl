@@ -1,7 +1,7 @@
 // ReSTIR reservoirs: a path record, its unbiased contribution weight W and its confidence M.
 // Stored as two 48-byte halves in separate bindings, so that a 1920x1080 frame needs 99.5 MB
 // per binding, under lavapipe's 128 MiB limit (one 96-byte array would need 199 MB).
-// Twins: ReservoirHead and ReservoirTail in src/gpu_types.rs (layout test).
+// Twins: ReservoirHead and ReservoirTail in crates/interface/src/gpu_types.rs (layout test).
 #ifndef RESERVOIR_GLSL
 #define RESERVOIR_GLSL
 
@@ -72,7 +72,7 @@ bool is_finite(float x) {
 // `expected` is the expectation of f(Y) W_Y over the choice, sum w_i f(y_i) / p̂(y_i): the
 // pixel is shaded with it, which removes the choice's noise (chiefly colour noise, as p̂ is
 // luminance) without bias. Twins: gris::Resampler, resampler_begin, resampler_offer and
-// resampler_finish in src/shading/gris.rs (`expected`: gris::resampled_expectation).
+// resampler_finish in crates/shading-core/src/gris.rs (`expected`: gris::resampled_expectation).
 struct Resampler {
     PathRecord chosen;
     float chosen_target;

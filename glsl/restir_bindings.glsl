@@ -1,12 +1,12 @@
 // The bindings every ReSTIR PT kernel shares (set 0, after the scene's 0-4, numbered by
-// RestirBinding in src/shader_interface.rs, which also sets RESTIR_MAX_PASSES), with loads and
+// RestirBinding in crates/interface/src/shader_interface.rs, which also sets RESTIR_MAX_PASSES), with loads and
 // stores by slot. Twins: ReuseParams, Surface, ReservoirHead/Tail, RestirStats and RestirPass
-// in src/gpu_types.rs. Each pass reads its slots from the frame's pass table, picked by a push
+// in crates/interface/src/gpu_types.rs. Each pass reads its slots from the frame's pass table, picked by a push
 // constant, so that one descriptor set serves every pass: reservoir slots 0-2 rotate between
 // initial candidates, reuse rounds and the previous frame's result; surface slots 0-1 alternate
 // between frames. Parameters live in storage buffers and the push constant is only an index:
 // lavapipe compiles a kernel again for each new value of a uniform or push constant that steers
-// its control flow (src/vk/buffer.rs), and the slots steer every load and store below.
+// its control flow (crates/vk/src/buffer.rs), and the slots steer every load and store below.
 #ifndef RESTIR_BINDINGS_GLSL
 #define RESTIR_BINDINGS_GLSL
 

@@ -7,7 +7,7 @@
 // paths are built with the steps trace_vertices() in shift_path.glsl regenerates them with
 // (nee_vertex, bsdf_vertex). Expects the scene bindings and the pass counters
 // local_nonfinite_weights and local_candidates_dropped (restir_bindings.glsl; an oracle kernel
-// declares its own). Twin: src/shading/candidates.rs.
+// declares its own). Twin: crates/shading/src/candidates.rs.
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
 

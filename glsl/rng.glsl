@@ -1,6 +1,6 @@
 // Counter-based random numbers keyed by (pixel, sample, seed) -> path seed, then by
 // (path seed, vertex, stream). Any prefix of a path can be regenerated from its seed alone,
-// which random replay relies on. Twin: src/shading/rng.rs (bit-exact).
+// which random replay relies on. Twin: crates/shading-core/src/rng.rs (bit-exact).
 #ifndef RNG_GLSL
 #define RNG_GLSL
 

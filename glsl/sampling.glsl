@@ -1,4 +1,4 @@
-// Warping uniforms to directions and points. Twin: src/shading/sampling.rs.
+// Warping uniforms to directions and points. Twin: crates/shading-core/src/sampling.rs.
 #ifndef SAMPLING_GLSL
 #define SAMPLING_GLSL
 

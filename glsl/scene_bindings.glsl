@@ -1,13 +1,13 @@
 // Set 0, bindings 0-4: the frame parameters and the scene (storage or uniform buffers, see below),
-// numbered by SceneBinding in src/shader_interface.rs. Kernels add their own from binding 5.
-// Twin of FrameParams: src/gpu_types.rs.
+// numbered by SceneBinding in crates/interface/src/shader_interface.rs. Kernels add their own from binding 5.
+// Twin of FrameParams: crates/interface/src/gpu_types.rs.
 #ifndef SCENE_BINDINGS_GLSL
 #define SCENE_BINDINGS_GLSL
 
 #include "types.glsl"
 
 // A read-only storage buffer, not a uniform buffer: lavapipe compiles a kernel again for every
-// new value of a uniform or push constant that steers its control flow (src/vk/buffer.rs).
+// new value of a uniform or push constant that steers its control flow (crates/vk/src/buffer.rs).
 layout(std430, set = 0, binding = SCENE_BINDING_FRAME_PARAMS) readonly buffer FrameParams {
     vec4 cam_position;   // w: tan(yfov / 2)
     vec4 cam_right;      // w: aspect ratio (width / height)

@@ -4,7 +4,7 @@
 // normals"); measure conversions and ray offsets keep the geometric normal.
 // Kernels of a scene without vertex normals and normal maps (SCENE_SHADING_NORMALS 0, set by
 // src/render/scene_gpu.rs) compile none of it and shade with the geometric normal.
-// Twins: Scene::shading_normal and Scene::hit_shading (src/scene/hit_surface.rs).
+// Twins: Scene::shading_normal and Scene::hit_shading (crates/scene/src/hit_surface.rs).
 #ifndef SHADING_FRAME_GLSL
 #define SHADING_FRAME_GLSL
 

@@ -1,7 +1,7 @@
 // Shift mappings of ReSTIR PT in primary sample space: random replay, reconnection and hybrid,
 // with their inverses, on path records. Built from path vertices (shift_vertex.glsl), regenerated
 // paths (shift_path.glsl) and the reconnection with its Jacobian (shift_reconnection.glsl).
-// Expects the scene bindings. Twin: src/shading/shift/, where the measure, the contribution and
+// Expects the scene bindings. Twin: crates/shading/src/shift/, where the measure, the contribution and
 // the Jacobians are described; docs/shift-mappings.md.
 #ifndef SHIFT_GLSL
 #define SHIFT_GLSL

@@ -1,6 +1,6 @@
 // Paths regenerated in primary sample space from a primary hit and a seed (random replay's
 // map, and the replayed prefix of the hybrid shift).
-// Expects the scene bindings. Twin: src/shading/shift/path.rs.
+// Expects the scene bindings. Twin: crates/shading/src/shift/path.rs.
 #ifndef SHIFT_PATH_GLSL
 #define SHIFT_PATH_GLSL
 

@@ -1,7 +1,7 @@
 // The reconnection of a predecessor to a record's x_r: the edge's BSDF, pdf and geometry term,
 // the BSDF at x_r towards x_{r+1}, the Jacobian of the shift that makes it, and the path record
 // that caches the base side's terms. Expects the scene bindings. Twin:
-// src/shading/shift/reconnection.rs.
+// crates/shading/src/shift/reconnection.rs.
 #ifndef SHIFT_RECONNECTION_GLSL
 #define SHIFT_RECONNECTION_GLSL
 

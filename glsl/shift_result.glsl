@@ -1,6 +1,6 @@
 // What every shift returns (shift_path.glsl, shift_reconnection.glsl, shift.glsl) and what the
 // reuse loop (resample_inputs.glsl) consumes; apart from the shifts, so that an oracle kernel of
-// the loop can return its own. Twin: ShiftResult in src/shading/shift/path.rs.
+// the loop can return its own. Twin: ShiftResult in crates/shading/src/shift/path.rs.
 #ifndef SHIFT_RESULT_GLSL
 #define SHIFT_RESULT_GLSL
 
@@ -12,7 +12,7 @@ struct ShiftResult {
     float jacobian;
     vec3 contribution;
 #ifdef SHIFT_ORACLE
-    // The vertices the shift made (see src/shading/shift/path.rs), which only the oracle test compares:
+    // The vertices the shift made (see crates/shading/src/shift/path.rs), which only the oracle test compares:
     // production kernels would copy them on every shift.
     uint vertex_count;
     vec3 vertices[MAX_PATH_LENGTH];

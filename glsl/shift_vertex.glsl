@@ -1,6 +1,6 @@
 // The vertices of ReSTIR PT's paths and what the shifts evaluate between two of them: the
 // reconnection test, visibility, the emission and light pdf at the end, and the end's MIS weight.
-// Expects the scene bindings. Twin: src/shading/shift/vertex.rs.
+// Expects the scene bindings. Twin: crates/shading/src/shift/vertex.rs.
 #ifndef SHIFT_VERTEX_GLSL
 #define SHIFT_VERTEX_GLSL
 

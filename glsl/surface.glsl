@@ -1,6 +1,6 @@
 // The surface at a hit: interpolated shading normal, tangent frame, texture coordinates and
 // vertex colour.
-// Expects the scene bindings. Twin: src/shading/surface.rs.
+// Expects the scene bindings. Twin: crates/shading-core/src/surface.rs.
 #ifndef SURFACE_GLSL
 #define SURFACE_GLSL
 

@@ -2,7 +2,7 @@
 // frame parameters and the scene arrays that traversal reads). Only kernels of a scene that has
 // them declare these bindings: SCENE_SURFACE (vertex normals, tangents, texture coordinates) and
 // SCENE_TEXTURES (textures, which need the coordinates), set by src/render/scene_gpu.rs.
-// Twins: src/shading/surface.rs (TriangleSurface), src/shading/texture.rs (TextureHeader, TextureSlot,
+// Twins: crates/shading-core/src/surface.rs (TriangleSurface), crates/shading-core/src/texture.rs (TextureHeader, TextureSlot,
 // MaterialTextures).
 #ifndef SURFACE_BINDINGS_GLSL
 #define SURFACE_BINDINGS_GLSL
@@ -15,7 +15,7 @@
 #ifndef SCENE_TEXTURES
 #define SCENE_TEXTURES 0
 #endif
-// The set and the first binding of SurfaceBinding (src/shader_interface.rs). Oracle kernels,
+// The set and the first binding of SurfaceBinding (crates/interface/src/shader_interface.rs). Oracle kernels,
 // which bind everything in set 0, move these bindings there.
 #ifndef SURFACE_SET
 #define SURFACE_SET SURFACE_DESCRIPTOR_SET

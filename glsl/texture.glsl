@@ -1,6 +1,6 @@
 // Material textures from the texel buffer: address modes, bilinear or nearest filtering, sRGB
 // decoding, and the material and shading normal a hit sees. Expects the scene bindings.
-// Twin: src/shading/texture.rs (docs/textures.md says why a buffer and not sampled images).
+// Twin: crates/shading-core/src/texture.rs (docs/textures.md says why a buffer and not sampled images).
 #ifndef TEXTURE_GLSL
 #define TEXTURE_GLSL
 

@@ -1,4 +1,4 @@
-// Scene records shared with the host. Twin: src/gpu_types.rs (a test checks every offset).
+// Scene records shared with the host. Twin: crates/interface/src/gpu_types.rs (a test checks every offset).
 #ifndef TYPES_GLSL
 #define TYPES_GLSL
 

@@ -21,24 +21,7 @@ pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Resul
     .map_err(|e| anyhow!("{}: cannot write EXR: {e}", path.display()))
 }
 
-/// Reads the first RGB(A) layer of an EXR: (width, height, row-major linear RGB pixels from the
-/// top left; alpha dropped).
-///
-/// # Errors
-/// The file cannot be read or holds no RGB layer; the message names `path`.
-pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| (resolution.width(), vec![Vec3::ZERO; resolution.width() * resolution.height()]),
-        |(w, pixels): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            pixels[pos.y() * *w + pos.x()] = Vec3::new(r, g, b)
-        },
-    )
-    .map_err(|e| anyhow!("{}: cannot read EXR: {e}", path.display()))?;
-    let size = image.layer_data.size;
-    Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
-}
+pub use crate::scene::environment::read_exr;
 
 /// The 8-bit sRGB code of a linear value (IEC 61966-2-1 transfer function; clamped to [0, 1],
 /// rounded to nearest).

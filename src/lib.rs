@@ -1,7 +1,12 @@
 //! restir-pt: a Vulkan compute path tracer with ReSTIR PT reuse through explicit shift mappings.
 //!
 //! The library is the renderer; the `restir-pt` binary (src/main.rs, src/app/) is one user of
-//! it. Embedding it takes four steps: load a [`scene::Scene`], open a [`vk::Context`], upload
+//! it. It is the top layer of a workspace whose crates are the layers below it, re-exported here
+//! under their module names (docs/layout.md): [`gpu_types`] and [`shader_interface`]
+//! (restir-pt-interface), [`vk`] and [`error`] (restir-pt-vk), [`scene`] (restir-pt-scene) and
+//! [`shading`] (restir-pt-shading, with restir-pt-shading-core's twins). This crate holds
+//! what needs both a scene and a device: [`render`], and what works on its images:
+//! [`metrics`], [`image_io`], [`reference_shard`]. Embedding it takes four steps: load a [`scene::Scene`], open a [`vk::Context`], upload
 //! the scene once ([`render::SceneGpu::upload`]) and build renderers on the upload, as many as
 //! needed ([`render::PathTracer`] for progressive path tracing, [`render::Restir`] for ReSTIR
 //! PT frames). Images come back as [`render::Image`] (linear RGB, row-major from the top left);
@@ -43,7 +48,8 @@
 //! Errors are `anyhow::Error` with one readable line naming the file or the value at fault;
 //! GPU failures a caller may want to tell apart (device loss, out of memory, limits) are
 //! [`error::GpuError`] inside them. The shading code exists twice: every GLSL function an
-//! oracle test mirrors has a Rust twin of the same name in [`shading`] (or [`scene::bvh`]).
+//! oracle test mirrors has a Rust twin of the same name in [`shading`] (the BVH traversal in
+//! [`shading::bvh`]).
 
 // Every public item carries a doc comment (units, spaces, layouts, errors, sources): a new
 // undocumented one fails the build, clippy and rustdoc alike.
@@ -51,13 +57,13 @@
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod error;
-pub mod gpu_types;
 pub mod image_io;
 pub mod metrics;
 pub mod reference_shard;
 pub mod render;
-pub mod scene;
-pub mod shader_interface;
-pub mod shading;
-pub mod vk;
+
+pub use restir_pt_interface::{gpu_types, shader_interface};
+pub use restir_pt_scene as scene;
+pub use restir_pt_shading as shading;
+pub use restir_pt_vk as vk;
+pub use restir_pt_vk::error;

@@ -1,6 +1,6 @@
 #version 460
 // Oracle kernel: bsdf_eval_pdf and bsdf_sample on given materials and directions
-// (twin: src/shading/bsdf.rs).
+// (twin: crates/shading-core/src/bsdf.rs).
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 

@@ -2,7 +2,7 @@
 // Oracle kernel: the initial candidates of one traced path per item (stream_path_candidates of
 // restir_candidates.glsl) streamed into a fresh Resampler, from primary hits and seeds the host
 // chose, with Russian roulette where the frame parameters' flags ask for it. Twin:
-// stream_path_candidates in src/shading/candidates.rs.
+// stream_path_candidates in crates/shading/src/candidates.rs.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 

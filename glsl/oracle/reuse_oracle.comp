@@ -1,7 +1,7 @@
 #version 460
 // Oracle kernel: the reuse loop (resample_inputs.glsl, MIS_MODE as compiled) on the analytic
 // domains of the GRIS toy (tests/suite/gris.rs), one resampling per item. Twin: resample_inputs
-// in src/shading/resample_inputs.rs on the same bridge (ToyDomains in tests/suite/reuse_oracle.rs).
+// in crates/shading/src/resample_inputs.rs on the same bridge (ToyDomains in tests/suite/reuse_oracle.rs).
 //
 // Domain 0 is the canonical (target) domain, p̂_0(y) = 1 + sin 3y on [0, 1]. Domain 1 shifts
 // into it by T(x) = x^2 on [0, 0.9], p̂_1(x) = 1 + x; domain 2 by T(x) = x + 0.3 on [0, 0.7],

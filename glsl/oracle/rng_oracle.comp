@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: RNG outputs for given keys (twin: src/shading/rng.rs). Bit-exact comparison.
+// Oracle kernel: RNG outputs for given keys (twin: crates/shading-core/src/rng.rs). Bit-exact comparison.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 

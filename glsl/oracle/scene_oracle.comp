@@ -1,6 +1,6 @@
 #version 460
 // Oracle kernel: BVH traversal, light sampling and camera rays against a real scene
-// (twins: src/scene/bvh.rs, src/shading/ray_offset.rs, src/shading/lights.rs, src/scene/camera.rs), and shadow rays
+// (twins: crates/shading-core/src/bvh.rs, crates/shading-core/src/ray_offset.rs, crates/shading/src/lights.rs, crates/scene/src/camera.rs), and shadow rays
 // to punctual lights.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;

@@ -2,7 +2,7 @@
 // Oracle kernel: one shift per item on records the host made, the function ORACLE_SHIFT names
 // (0 to 2: shift_reconnection, shift_random_replay, shift_hybrid; 3 to 5: inverse_reconnection,
 // inverse_random_replay, inverse_hybrid), each compiled alone. Twins: the functions of the same
-// names in src/shading/shift/.
+// names in crates/shading/src/shift/.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 

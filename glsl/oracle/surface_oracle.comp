@@ -2,7 +2,7 @@
 // Oracle kernel: surface_at (with vertex_color), triangle_bary, texture_lookup,
 // texture_coordinates, texture_tangent_frame, textured_material, normal_mapped, shading_normal and
 // hit_shading on a scene with attributes
-// and textures (twins: src/shading/surface.rs, src/shading/texture.rs, src/scene/hit_surface.rs). Everything is bound in set 0: the scene at 0-4,
+// and textures (twins: crates/shading-core/src/surface.rs, crates/shading-core/src/texture.rs, crates/scene/src/hit_surface.rs). Everything is bound in set 0: the scene at 0-4,
 // the surface bindings at 5-8, then inputs and outputs.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;

@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: trace_pair against a real scene (twin: trace_pair in src/scene/bvh.rs). Compiled with
+// Oracle kernel: trace_pair against a real scene (twin: trace_pair in crates/shading-core/src/bvh.rs). Compiled with
 // the scene's defines, and with SCENE_BRUTE_FORCE=1 for the brute-force form.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;

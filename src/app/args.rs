@@ -192,7 +192,7 @@ impl SceneArgs {
     }
 
     /// What to load besides the file; `array_limit` is the device's limit on one scene array
-    /// (`Context::scene_array_limit`), None before a device is open.
+    /// (`render::scene_array_limit`), None before a device is open.
     pub fn load_options(&self, array_limit: Option<ArrayLimit>) -> LoadOptions {
         LoadOptions {
             scene: self.scene_index,

@@ -12,7 +12,7 @@ use super::render_loop::{render_path_traced, render_restir, Job};
 use super::render_output::{check_extension, create_parent, Outputs};
 use super::{finish_device, load_with_options, open_device};
 use restir_pt::image_io::Exposure;
-use restir_pt::render::{RenderSettings, RestirSettings, SceneGpu, SceneInfo};
+use restir_pt::render::{scene_array_limit, RenderSettings, RestirSettings, SceneGpu, SceneInfo};
 use restir_pt::scene::{camera_on_path, Scene};
 
 /// The rendering method.
@@ -307,7 +307,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     // The device first: its per-array limit lets the loader refuse an oversized scene from its
     // accessor counts, before reading vertices or building the BVH.
     let ctx = open_device(&args.device)?;
-    let scene = load_with_options(&path, &args.scene.load_options(Some(ctx.scene_array_limit())))?;
+    let scene = load_with_options(&path, &args.scene.load_options(Some(scene_array_limit(&ctx))))?;
     if let Some(line) = scene.surface_summary() {
         eprintln!("{line}");
     }

@@ -9,10 +9,7 @@ pub use flip::{hdr_flip, hdr_flip_exposures, hdr_flip_map, ldr_flip_map, PIXELS_
 /// Guards relMSE's denominator where the reference is black (the usual 1e-2 of the literature).
 pub const REL_MSE_EPSILON: f32 = 1e-2;
 
-/// Relative luminance of linear Rec. 709 / sRGB primaries (ITU-R BT.709 weights).
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
+pub use crate::scene::luminance;
 
 fn check_sizes(image: &[Vec3], reference: &[Vec3]) {
     assert_eq!(image.len(), reference.len(), "an image and its reference differ in size");

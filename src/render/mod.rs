@@ -51,7 +51,7 @@ pub use image::Image;
 pub use path_tracer::{PathTracer, RenderStats};
 pub use restir::{FrameStats, Restir};
 pub use restir_settings::{RestirSettings, ReuseMis, ShiftKind, MAX_RESERVOIRS};
-pub use scene_gpu::SceneGpu;
+pub use scene_gpu::{scene_array_limit, SceneGpu};
 pub use scene_info::SceneInfo;
 pub use settings::{RenderSettings, MAX_IMAGE_SIDE, MAX_PIXELS};
 pub use surface_gpu::SurfaceGpu;

@@ -10,9 +10,9 @@ use super::counters::{TraversalCounters, COUNTER_COUNT};
 use super::image_readback::AccumReadback;
 use super::{Image, RenderSettings, SceneGpu};
 use crate::error::GpuError;
-use crate::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES;
 use crate::shader_interface::{PathTraceBinding, IMAGE_LOCAL_SIZE};
-use crate::vk::{record_compute_barrier, Binding, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
+use crate::shading::bvh::BRUTE_FORCE_MAX_TRIANGLES;
+use crate::vk::{record_compute_barrier, Binding, BindingFamilyExt, Buffer, BufferUsage, Context, Kernel, KernelCompile, PassTimer};
 
 /// Submissions are sized to about this much GPU time, which keeps GPU watchdogs far away.
 const TARGET_SUBMISSION_MS_GPU: f64 = 250.0;

@@ -19,8 +19,8 @@ use crate::scene::Camera;
 use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
 use crate::shading::shift::ShiftParams;
 use crate::vk::{
-    compile_kernels_in_parallel, process_cpu_ms, twin_compile_pays, warm_up_on_twin, Binding, CompiledKernel, Context, Kernel,
-    KernelCompile, PassTimer, TwinKernel,
+    compile_kernels_in_parallel, process_cpu_ms, twin_compile_pays, warm_up_on_twin, Binding, BindingFamilyExt, CompiledKernel, Context,
+    Kernel, KernelCompile, PassTimer, TwinKernel,
 };
 
 mod buffers;
@@ -201,7 +201,7 @@ impl Restir {
     /// start-up, not to a frame's GPU time. Where a twin device pays (`twin_compile_pays`),
     /// about half of the kernels, by SPIR-V size, are first compiled on a twin device on
     /// another thread while this thread builds the other half, and then found in the driver's
-    /// disk cache (src/vk/twin_compile.rs).
+    /// disk cache (crates/vk/src/twin_compile.rs).
     fn build(&mut self, wanted: &[PassKernel], progress: &dyn Fn(&str)) -> Result<()> {
         let (start, cpu) = (Instant::now(), process_cpu_ms());
         let mut todo: Vec<PassKernel> = Vec::new();
@@ -305,7 +305,7 @@ impl Restir {
     }
 
     /// How many of the kernels built so far a twin device compiled first, into the driver's
-    /// disk cache, while this device compiled the others (src/vk/twin_compile.rs); 0 where no
+    /// disk cache, while this device compiled the others (crates/vk/src/twin_compile.rs); 0 where no
     /// twin paid or it failed.
     pub fn twin_warmed_kernels(&self) -> usize {
         self.twin_warmed

@@ -15,11 +15,11 @@ use ash::vk::PhysicalDeviceType;
 
 use crate::error::GpuError;
 use crate::gpu_types::{Emitter, Material, Triangle, LIGHT_NODE_ROWS, PUNCTUAL_ROWS};
-use crate::scene::Scene;
+use crate::scene::{ArrayLimit, Scene};
 use crate::shader_interface::SceneBinding;
 use crate::shading::bsdf::{has_specular_layer, lobe_weights};
 use crate::shading::texture::NO_TEXTURE;
-use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, CompiledKernel, Context, Kernel};
+use crate::vk::{Binding, BindingFamilyExt, BindingSlot, BoundBuffer, Buffer, BufferUsage, CompiledKernel, Context, Kernel};
 
 use super::surface_gpu::SurfaceGpu;
 use super::SceneInfo;
@@ -292,4 +292,22 @@ fn scene_defines(scene: &Scene, uniform: bool) -> Vec<(&'static str, String)> {
         ]);
     }
     defines
+}
+
+/// The most bytes one scene array may take on `ctx`'s device: a buffer reached by device address
+/// where the device has bufferDeviceAddress, else one storage binding. The loader's budget
+/// (`scene::LoadOptions`) takes it; it lives here, where the scene meets the device, because
+/// neither layer knows the other.
+pub fn scene_array_limit(ctx: &Context) -> ArrayLimit {
+    if ctx.info.buffer_device_address {
+        ArrayLimit {
+            bytes: ctx.info.max_allocation_bytes,
+            name: "maxMemoryAllocationSize",
+        }
+    } else {
+        ArrayLimit {
+            bytes: ctx.info.max_storage_buffer_range,
+            name: "maxStorageBufferRange",
+        }
+    }
 }

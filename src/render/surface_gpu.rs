@@ -8,7 +8,7 @@ use anyhow::{Context as _, Result};
 use crate::error::GpuError;
 use crate::scene::Scene;
 use crate::shader_interface::SurfaceBinding;
-use crate::vk::{Binding, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context};
+use crate::vk::{Binding, BindingFamilyExt, BindingSlot, BoundBuffer, Buffer, BufferUsage, Context};
 
 use super::scene_gpu::address_record;
 

@@ -1,17 +1,17 @@
 //! GLSL alpha testing in traversal (glsl/alpha.glsl inside `bvh_traverse` and `trace_pair`)
-//! against its Rust twins (src/shading/alpha.rs `alpha_keeps` and `alpha_hash`,
-//! src/scene/bvh.rs `bvh_traverse` and `trace_pair`, src/shading/texture.rs
+//! against its Rust twins (crates/shading-core/src/alpha.rs `alpha_keeps` and `alpha_hash`,
+//! crates/shading-core/src/bvh.rs `bvh_traverse` and `trace_pair`, crates/shading-core/src/texture.rs
 //! `material_alpha`) on random triangles with opaque, MASK (textured and not) and BLEND
 //! (textured and not) materials.
 
 use glam::{Vec2, Vec3, Vec4};
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::render::SceneGpu;
-use restir_pt::scene::alpha_trace::bvh_alpha_pass;
-use restir_pt::scene::bvh::{bvh_traverse, intersect_triangle, trace_pair, Hit, PairRay, NO_HIT};
 use restir_pt::scene::{Camera, Scene, SceneParts};
 use restir_pt::shading::alpha::{alpha_hash, alpha_keeps, AlphaScene};
 use restir_pt::shading::alpha_pass::{alpha_pass_begin, alpha_pass_new, alpha_pass_resolve};
+use restir_pt::shading::alpha_trace::bvh_alpha_pass;
+use restir_pt::shading::bvh::{bvh_traverse, intersect_triangle, trace_pair, Hit, PairRay, NO_HIT};
 use restir_pt::shading::surface::TriangleSurface;
 use restir_pt::shading::texture::{
     material_alpha, MaterialTextures, SceneTextures, TextureHeader, TextureSlot, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE, TEXTURE_WRAP_REPEAT,
@@ -270,7 +270,7 @@ fn alpha_traversal_glsl_matches_rust() {
 #[test]
 fn alpha_brute_force_pair_glsl_matches_rust() {
     let scene = alpha_random_scene(31, 24, 1.0, true);
-    assert!(scene.triangles.len() <= restir_pt::scene::bvh::BRUTE_FORCE_MAX_TRIANGLES);
+    assert!(scene.triangles.len() <= restir_pt::shading::bvh::BRUTE_FORCE_MAX_TRIANGLES);
     let inputs = alpha_oracle_inputs(&scene, 32, 1.5);
     let out = run_alpha_oracle(&scene, &inputs, true);
     let n = compare_alpha_oracle(&scene, &inputs, &out, true);

@@ -6,9 +6,9 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3, Vec4};
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
 use restir_pt::render::{RenderSettings, SceneGpu};
-use restir_pt::scene::bvh::{trace_closest, trace_occluded, NO_HIT};
 use restir_pt::scene::gltf_writer::MeshData;
 use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
+use restir_pt::shading::bvh::{trace_closest, trace_occluded, NO_HIT};
 use restir_pt::shading::lights::{sample_light, LightSample};
 use restir_pt::shading::ray_offset::offset_ray_origin;
 use restir_pt::vk::{Buffer, BufferUsage, Context};
@@ -304,7 +304,7 @@ fn bvh_closest_hit_equals_brute_force() {
         let h = trace_closest(&scene.nodes, &scene.triangles, o, d, 1e30);
         let mut best = (1e30f32, NO_HIT);
         for (k, tri) in scene.triangles.iter().enumerate() {
-            if let Some((t, _)) = restir_pt::scene::bvh::intersect_triangle(o, d, tri, best.0) {
+            if let Some((t, _)) = restir_pt::shading::bvh::intersect_triangle(o, d, tri, best.0) {
                 best = (t, k as u32);
             }
         }
@@ -334,7 +334,7 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
 
 /// The environment half of light sampling with an equirectangular map (the scene's emitters beside
 /// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (lights.glsl, compiled
-/// with the scene's SCENE_ENV_MAP defines) against their Rust twins in src/shading/lights.rs.
+/// with the scene's SCENE_ENV_MAP defines) against their Rust twins in crates/shading/src/lights.rs.
 /// Run unrotated and turned by 37 degrees (`--env-rotation`, the header's cosine and sine).
 #[test]
 fn environment_map_light_sampling_glsl_matches_rust() {

@@ -1,13 +1,13 @@
 //! GLSL `stream_path_candidates` (glsl/restir_candidates.glsl, the initial pass's candidates)
-//! against its Rust twin `stream_path_candidates` (src/shading/candidates.rs): one traced path
+//! against its Rust twin `stream_path_candidates` (crates/shading/src/candidates.rs): one traced path
 //! per item from a primary hit of camera 0 with its own seed, its light-ending prefixes streamed
 //! into a fresh Resampler on both sides, with and without Russian roulette; the chosen record,
 //! the weight sum, W, the expectation and the pass counters compared.
 
 use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
-use restir_pt::scene::bvh::NO_HIT;
 use restir_pt::scene::Scene;
+use restir_pt::shading::bvh::NO_HIT;
 use restir_pt::shading::candidates::stream_path_candidates;
 use restir_pt::shading::gris::{resampler_begin, resampler_finish};
 use restir_pt::shading::path_record::{PathRecord, MAX_PATH_LENGTH};

@@ -133,7 +133,7 @@ pub fn run_surface_set0_oracle_with(
 ) -> Vec<glam::Vec4> {
     use restir_pt::gpu_types::FrameParams;
     use restir_pt::shader_interface::SurfaceBinding;
-    use restir_pt::vk::{Binding, BufferUsage};
+    use restir_pt::vk::{Binding, BindingFamilyExt, BufferUsage};
     let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
     let params = Buffer::new(ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
     params.write(&[FrameParams::default()]).unwrap();

@@ -1,4 +1,4 @@
-//! The default environment decided from what a file holds (src/scene/default_environment.rs):
+//! The default environment decided from what a file holds (crates/scene/src/default_environment.rs):
 //! the bundled scenes, closed around their own lights, keep no environment (their images are
 //! checked unchanged by tests/suite/scenes.rs); an open asset with its own emitters gets the
 //! viewer-like one with a line saying so; lightless assets get it as before; `--env none` turns

@@ -8,9 +8,9 @@ use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
 use restir_pt::render::{Image, PathTracer, RenderSettings, SceneGpu};
-use restir_pt::scene::bvh::{trace_closest, NO_HIT};
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData, FILTER_LINEAR, WRAP_REPEAT};
 use restir_pt::scene::{load_scene_from_bytes_with_options, LoadOptions, Scene};
+use restir_pt::shading::bvh::{trace_closest, NO_HIT};
 use serde_json::json;
 
 use crate::common::{assert_clean, gpu, repo_path};
@@ -265,8 +265,8 @@ fn gltf_corners_emitter_alpha_weights_the_emission() {
     // Looking up through the label: its transparent texels show no emission and no surface.
     let o = Vec3::new(-0.25, 0.5, 0.0) - label.origin.as_vec3();
     let (hit_transparent, hit_opaque) = (
-        restir_pt::scene::alpha_trace::bvh_traverse(&label.nodes, &label.triangles, &label.alpha().unwrap(), o, Vec3::Y, 1e30, false),
-        restir_pt::scene::alpha_trace::bvh_traverse(
+        restir_pt::shading::alpha_trace::bvh_traverse(&label.nodes, &label.triangles, &label.alpha().unwrap(), o, Vec3::Y, 1e30, false),
+        restir_pt::shading::alpha_trace::bvh_traverse(
             &label.nodes,
             &label.triangles,
             &label.alpha().unwrap(),

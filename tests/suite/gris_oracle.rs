@@ -1,7 +1,7 @@
 //! GLSL against Rust for resampling: `mis_weight` of glsl/gris.glsl (generalized balance
 //! heuristic and pairwise MIS) against `gris::mis_weight`, and the streaming resampler of
 //! glsl/reservoir.glsl (`Resampler`, `resampler_begin`, `resampler_add`/`resampler_offer`,
-//! `resampler_finish`) against its twins in src/shading/gris.rs, on recorded inputs: tables of
+//! `resampler_finish`) against its twins in crates/shading-core/src/gris.rs, on recorded inputs: tables of
 //! confidence weights and p̂_{<-l}(y_i) with failed shifts (zeros) and six decades of range, and
 //! offered candidates with zero weights and lost choices, as the reuse passes see them.
 

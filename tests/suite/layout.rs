@@ -1,8 +1,8 @@
 //! Host structs against the GLSL layout: member offsets and array strides read from the SPIR-V
 //! that glslang produced (OpMemberDecorate Offset, OpDecorate ArrayStride) must equal the
-//! `#[repr(C)]` offsets and sizes of the Rust twins in src/gpu_types.rs; and every kernel's
+//! `#[repr(C)]` offsets and sizes of the Rust twins in crates/interface/src/gpu_types.rs; and every kernel's
 //! descriptor bindings (number, block name, descriptor type) must be those that
-//! src/shader_interface.rs declares.
+//! crates/interface/src/shader_interface.rs declares.
 
 use std::collections::HashMap;
 
@@ -12,7 +12,7 @@ use restir_pt::gpu_types::{
 use restir_pt::render::{PassKernel, ReuseMis, ShiftKind};
 use restir_pt::shader_interface::{PathTraceBinding, RestirBinding, SceneBinding, SurfaceBinding};
 use restir_pt::shading::path_record::PathRecord;
-use restir_pt::vk::{check_bindings, compile_kernel, reflect_bindings, Binding, BindingSlot};
+use restir_pt::vk::{check_bindings, compile_kernel, reflect_bindings, Binding, BindingFamilyExt, BindingSlot};
 
 const OP_NAME: u32 = 5;
 const OP_MEMBER_NAME: u32 = 6;
@@ -201,7 +201,7 @@ fn assert_bindings(kernel: &str, defines: &[(&str, &str)], layout: &[BindingSlot
         assert_eq!(
             host.map(|s| (s.block, s.kind)),
             Some((b.block.as_str(), b.kind)),
-            "{kernel} {defines:?}: binding {} in src/shader_interface.rs (left) vs SPIR-V (right)",
+            "{kernel} {defines:?}: binding {} in crates/interface/src/shader_interface.rs (left) vs SPIR-V (right)",
             b.binding
         );
     }

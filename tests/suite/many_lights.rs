@@ -39,7 +39,7 @@ fn lamp_scene(name: &str, ground: f32, lamp: f32, extra: &[(Value, Vec3, Vec3)])
 }
 
 /// The scene of glTF `text` lit by its lights alone: a sun would otherwise bring the viewer's
-/// default sky (src/scene/default_environment.rs), whose noise is not the lamps'.
+/// default sky (crates/scene/src/default_environment.rs), whose noise is not the lamps'.
 fn without_default_sky(name: &str, text: &str) -> Scene {
     let options = LoadOptions {
         no_environment: true,

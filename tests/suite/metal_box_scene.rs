@@ -1,7 +1,7 @@
 //! A generated scene of the kind real files hold, for the unbiasedness tests of temporal reuse:
 //! a GGX conductor box standing on a large diffuse floor, lit by punctual lights placed behind it,
 //! so that the faces the cameras see receive their light only through the floor (camera → metal →
-//! floor → light). Written with src/scene/gltf_writer.
+//! floor → light). Written with crates/scene/src/gltf_writer.
 
 use glam::Vec3;
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};

@@ -1,7 +1,7 @@
 //! A generated scene whose shading frames differ from the geometric ones almost everywhere, for
 //! the shift and ReSTIR tests: the Cornell room with a normal-mapped floor and back wall, a
 //! coarse sphere with interpolated normals and a normal-mapped one (tangents from MikkTSpace),
-//! beside walls without vertex attributes (face normals). Written with src/scene/gltf_writer.
+//! beside walls without vertex attributes (face normals). Written with crates/scene/src/gltf_writer.
 
 use glam::{Vec2, Vec3};
 use restir_pt::scene::gltf_writer::{textured_sphere, GltfBuilder, MaterialSpec, MeshData, FILTER_LINEAR, WRAP_REPEAT};

@@ -1,11 +1,11 @@
-//! `offset_ray_origin` (src/shading/ray_offset.rs) against an exact oracle: triangles at scales 1e-5 to
+//! `offset_ray_origin` (crates/shading-core/src/ray_offset.rs) against an exact oracle: triangles at scales 1e-5 to
 //! 1e5 and translated up to 1e5, points computed from barycentrics in f32 as the kernels do, the
 //! plane evaluated in f64. The GLSL twin is checked against it in bvh_oracle
 //! (`bvh_traversal_lights_and_camera_glsl_matches_rust`).
 
 use glam::{DVec3, Vec3};
 use restir_pt::gpu_types::{Triangle, NO_EMITTER};
-use restir_pt::scene::bvh::intersect_triangle;
+use restir_pt::shading::bvh::intersect_triangle;
 use restir_pt::shading::ray_offset::{offset_ray_origin, RAY_OFFSET_SCALE};
 
 use crate::common::TestRng;
@@ -16,7 +16,7 @@ fn dvec(v: [f32; 3]) -> DVec3 {
 
 /// A random triangle of size about `scale` around `center`, stored like the loader stores it
 /// (vertex 0 and edges in f32), whose stored smallest angle is at least 3° (the bound of
-/// src/shading/ray_offset.rs); None where f32 cannot hold it (a triangle far smaller than its distance
+/// crates/shading-core/src/ray_offset.rs); None where f32 cannot hold it (a triangle far smaller than its distance
 /// from the origin collapses, which is why the loader re-centres scenes).
 fn random_triangle(r: &mut TestRng, center: DVec3, scale: f64) -> Option<Triangle> {
     let v: Vec<DVec3> = (0..3).map(|_| center + scale * r.unit_vector().as_dvec3()).collect();

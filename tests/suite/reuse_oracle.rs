@@ -1,6 +1,6 @@
 //! The reuse loop of ReSTIR PT on the GRIS toy's analytic domains (tests/suite/gris.rs): GLSL
 //! `resample_inputs` (glsl/resample_inputs.glsl, run by glsl/oracle/reuse_oracle.comp on the toy
-//! bridge) against its twin `resample_inputs` (src/shading/resample_inputs.rs on the same bridge,
+//! bridge) against its twin `resample_inputs` (crates/shading/src/resample_inputs.rs on the same bridge,
 //! `ToyDomains`), the twin against the reference estimator `gris::resampled_expectation`, and
 //! the twin's f(Y) W_Y against the integral. Up to 9 inputs per resampling, from the canonical
 //! domain (identity shifts), from domains whose shifts fail on part of them, and empty ones.
@@ -127,7 +127,7 @@ impl ReuseBridge for ToyDomains<'_> {
     }
 }
 
-/// The same domains in double precision for the reference estimator (src/shading/gris.rs):
+/// The same domains in double precision for the reference estimator (crates/shading-core/src/gris.rs):
 /// sample i is input i's position, shifted by its domain's map.
 impl Domains<f64> for ToyDomains<'_> {
     fn shift(&self, i: usize, x: f64) -> Option<(f64, f64)> {

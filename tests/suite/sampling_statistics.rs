@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_pt::gpu_types::NO_EMITTER;
 use restir_pt::metrics::{mean, standard_error};
-use restir_pt::scene::bvh::intersect_triangle;
 use restir_pt::shading::bsdf::{ggx_vndf_pdf, smith_g1};
+use restir_pt::shading::bvh::intersect_triangle;
 use restir_pt::shading::lights::sample_light;
 use restir_pt::shading::sampling::{sample_cosine_hemisphere, sample_ggx_vndf, sample_triangle};
 
@@ -353,7 +353,7 @@ fn environment_map_sampling_fits(map: restir_pt::scene::environment::Environment
     assert!((mean - 1.0).abs() < 4.0 * se, "pdf integrates to {mean} +- {se}");
 }
 
-/// The map's orientation is Mitsuba 3's (src/scene/environment.rs): the centre column faces +Z,
+/// The map's orientation is Mitsuba 3's (crates/scene/src/environment.rs): the centre column faces +Z,
 /// u = 1/4 faces +X, the left edge -Z, the top row +Y; `--env-rotation 90` brings the centre
 /// column to +X (right-handed about +Y), and radiance, pdf and sampling turn together.
 #[test]

@@ -36,7 +36,7 @@ fn real_scenes_array_limit_is_checked_from_accessor_counts_before_loading() {
     // one binding are reached by device address, tests/suite/scale.rs): refused from the counts,
     // at once.
     let ctx = crate::common::gpu();
-    if ctx.scene_array_limit().bytes < (1 << 15) * (TILE_TRIANGLES as u64) * 48 {
+    if restir_pt::render::scene_array_limit(&ctx).bytes < (1 << 15) * (TILE_TRIANGLES as u64) * 48 {
         let big = crate::common::temp_file("floor15.gltf", tiled_floor(15).as_bytes());
         let (code, _, stderr) = restir_pt(&[
             "render",
@@ -51,7 +51,7 @@ fn real_scenes_array_limit_is_checked_from_accessor_counts_before_loading() {
             "8",
         ]);
         assert_eq!(code, 1, "{stderr}");
-        let limit = ctx.scene_array_limit().name;
+        let limit = restir_pt::render::scene_array_limit(&ctx).name;
         assert!(
             stderr.contains("floor15.gltf") && stderr.contains("about 67108864 triangles") && stderr.contains(limit),
             "{stderr}"

@@ -1,4 +1,4 @@
-//! The shift mappings' Rust reference (src/shading/shift/) on the bundled scenes: round trips,
+//! The shift mappings' Rust reference (crates/shading/src/shift/) on the bundled scenes: round trips,
 //! reciprocal Jacobians, finite-difference Jacobians, injectivity and clean failure; the GLSL
 //! twins against it are in shift_oracle.rs.
 //! `cargo test --release shift` runs them all.
@@ -372,8 +372,8 @@ struct Causes {
 
 #[test]
 fn shift_fails_cleanly_on_delta_occluded_short_back_facing_and_diverging_paths() {
-    use restir_pt::scene::bvh::trace_occluded;
     use restir_pt::shading::bsdf::{bsdf_eval_pdf, has_specular_layer, lobe_weights};
+    use restir_pt::shading::bvh::trace_occluded;
     use restir_pt::shading::ray_offset::offset_ray_origin;
     let mut total = Causes::default();
     let mut diverged = 0;

@@ -1,5 +1,5 @@
 //! The non-metal's GGX specular layer (docs/materials.md): the layer never gains energy (a
-//! furnace of glsl/oracle/bsdf_oracle.comp and src/shading/bsdf.rs over roughness, IOR, specular factor,
+//! furnace of glsl/oracle/bsdf_oracle.comp and crates/shading-core/src/bsdf.rs over roughness, IOR, specular factor,
 //! specular colour and angle), its sampling follows its pdf (chi-square at the 1% level), the
 //! loader reads `KHR_materials_specular` and `KHR_materials_ior` into it, and roughness changes
 //! a non-metal's BSDF and image (it changed nothing before the layer existed).

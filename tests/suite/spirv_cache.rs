@@ -1,4 +1,4 @@
-//! The on-disk SPIR-V cache (src/vk/spirv_cache.rs): an entry is written on a miss and read back
+//! The on-disk SPIR-V cache (crates/vk/src/spirv_cache.rs): an entry is written on a miss and read back
 //! on the next compile, a corrupt entry is compiled again and replaced, other defines are another
 //! entry, and `RESTIR_PT_SPIRV_CACHE` places the cache or turns it off for the binary.
 

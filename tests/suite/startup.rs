@@ -88,7 +88,7 @@ fn assert_same_frames(got: &[Vec<u32>], expected: &[Vec<u32>]) {
     }
 }
 
-// Kernels warmed up on a twin device (src/vk/twin_compile.rs) while the renderer's device
+// Kernels warmed up on a twin device (crates/vk/src/twin_compile.rs) while the renderer's device
 // compiles the others: the renderer still creates and dispatches every kernel itself, and its
 // frames equal, bit for bit, those of a renderer built without a twin. The twin runs only on
 // unvalidated CPU devices with a second core (the validation layer of Debian 12 races between

@@ -1,13 +1,13 @@
-//! Textured scenes made by the generator (src/scene/gltf_writer/textures.rs): the textured furnace,
+//! Textured scenes made by the generator (crates/scene/src/gltf_writer/textures.rs): the textured furnace,
 //! and the loader's reading of samplers, texture coordinate sets and KHR_texture_transform.
 
 use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
 use restir_pt::render::{PathTracer, RenderSettings, SceneGpu};
-use restir_pt::scene::bvh::{trace_closest, NO_HIT};
 use restir_pt::scene::gltf_writer::{textured_sphere, GltfBuilder, MaterialSpec, FILTER_LINEAR, WRAP_CLAMP_TO_EDGE, WRAP_REPEAT};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
+use restir_pt::shading::bvh::{trace_closest, NO_HIT};
 use serde_json::json;
 
 use crate::common::{assert_clean, gpu};

@@ -1,4 +1,4 @@
-//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (src/scene/bvh.rs), in
+//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (crates/shading-core/src/bvh.rs), in
 //! both forms: the BVH traversed once for a closest-hit and a shadow ray, and the brute-force
 //! pass of small uniform-buffer scenes; and the twin against `trace_closest`/`trace_occluded`.
 
@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 use restir_pt::render::{RenderSettings, SceneGpu};
-use restir_pt::scene::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::scene::{load_scene, Scene};
+use restir_pt::shading::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::vk::{BindingSlot, Buffer, BufferUsage, Context, Kernel};
 
 use crate::bvh_oracle::random_scene;

@@ -9,7 +9,7 @@ use super::super::reservoir_layers::ReservoirLayers;
 use super::super::SceneGpu;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
 use crate::shader_interface::{RestirBinding, SURFACE_SLOTS};
-use crate::vk::{BoundBuffer, Buffer, BufferUsage, Context};
+use crate::vk::{BindingFamilyExt, BoundBuffer, Buffer, BufferUsage, Context};
 
 pub(super) struct RestirBuffers {
     /// `FrameParams`, host-written before each frame.
