@@ -4,122 +4,18 @@
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
+use restir_pt::gpu_types::NO_EMITTER;
 use restir_pt::render::{RenderSettings, SceneGpu};
-use restir_pt::scene::gltf_writer::MeshData;
-use restir_pt::scene::{Camera, PunctualKind, PunctualLight, Scene, SceneParts};
+use restir_pt::scene::Scene;
 use restir_pt::shading::bvh::{trace_closest, trace_occluded, NO_HIT};
 use restir_pt::shading::lights::{sample_light, LightSample};
 use restir_pt::shading::ray_offset::offset_ray_origin;
 use restir_pt::vk::{Buffer, BufferUsage, Context};
 
 use crate::common::{assert_clean, close, gpu, run_oracle_with_defines, TestRng};
+use crate::fixtures::random_scenes::{random_scene, random_scene_full, random_scene_with_punctual_lights};
 
 const RAYS: usize = 20_000;
-
-/// Random triangles, a sphere and emitters, without punctual lights.
-pub fn random_scene(seed: u64) -> Scene {
-    random_scene_lit(seed, vec![])
-}
-
-/// `random_scene` with three punctual lights (point, spot, directional) beside its emitters.
-pub fn random_scene_with_punctual_lights(seed: u64) -> Scene {
-    random_scene_lit(
-        seed,
-        vec![
-            PunctualLight {
-                kind: PunctualKind::Point,
-                position: Vec3::new(0.5, 3.0, 1.0),
-                direction: -Vec3::Y,
-                intensity: Vec3::new(20.0, 15.0, 10.0),
-                cos_inner: 1.0,
-                cos_outer: -1.0,
-            },
-            PunctualLight {
-                kind: PunctualKind::Spot,
-                position: Vec3::new(-2.0, 4.0, 0.0),
-                direction: Vec3::new(0.3, -1.0, 0.1).normalize(),
-                intensity: Vec3::splat(40.0),
-                cos_inner: 0.9,
-                cos_outer: 0.5,
-            },
-            PunctualLight {
-                kind: PunctualKind::Directional,
-                position: Vec3::ZERO,
-                direction: Vec3::new(-0.2, -1.0, 0.4).normalize(),
-                intensity: Vec3::splat(0.1),
-                cos_inner: 1.0,
-                cos_outer: -1.0,
-            },
-        ],
-    )
-}
-
-fn random_scene_lit(seed: u64, lights: Vec<PunctualLight>) -> Scene {
-    random_scene_full(seed, lights, None)
-}
-
-fn random_scene_full(
-    seed: u64,
-    lights: Vec<PunctualLight>,
-    environment_map: Option<restir_pt::scene::environment::EnvironmentMap>,
-) -> Scene {
-    let mut r = TestRng(seed);
-    let mut triangles = Vec::new();
-    for i in 0..6000 {
-        let center = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
-        let size = 0.05 + 0.5 * r.uniform();
-        let v: Vec<Vec3> = (0..3).map(|_| center + size * r.unit_vector()).collect();
-        let material = if i % 50 == 0 { 1 } else { 0 };
-        triangles.push(Triangle {
-            v0: v[0].into(),
-            material,
-            e1: (v[1] - v[0]).into(),
-            emitter: NO_EMITTER,
-            e2: (v[2] - v[0]).into(),
-            alpha_tested: 0,
-        });
-    }
-    let sphere = MeshData::sphere(Vec3::new(1.0, 0.5, -0.5), 2.0, 16, 32);
-    for t in sphere.indices.chunks(3) {
-        let [a, b, c] = [0, 1, 2].map(|k| sphere.positions[t[k] as usize]);
-        triangles.push(Triangle {
-            v0: a.into(),
-            material: 0,
-            e1: (b - a).into(),
-            emitter: NO_EMITTER,
-            e2: (c - a).into(),
-            alpha_tested: 0,
-        });
-    }
-    let materials = vec![
-        Material {
-            base_color: [0.5; 3],
-            roughness: 1.0,
-            ior: 1.5,
-            ..Default::default()
-        },
-        Material {
-            emission: [4.0, 3.0, 2.0],
-            roughness: 1.0,
-            ior: 1.5,
-            ..Default::default()
-        },
-    ];
-    Scene::build(SceneParts {
-        source: "random test scene".into(),
-        surfaces: Vec::new(),
-        textures: Default::default(),
-        triangles,
-        materials,
-        material_names: vec!["grey".into(), "light".into()],
-        environment: Vec3::new(0.2, 0.3, 0.4),
-        environment_map,
-        cameras: vec![Camera::look_at("test", Vec3::new(0.0, 1.0, 12.0), Vec3::ZERO, Vec3::Y, 0.8)],
-        lights,
-        warnings: vec![],
-    })
-}
 
 #[test]
 fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
@@ -345,7 +241,7 @@ fn environment_map_light_sampling_glsl_matches_rust() {
 
 fn environment_map_light_sampling_matches(degrees: f32) {
     let ctx = gpu();
-    let map = crate::sampling_statistics::test_environment_map().with_rotation(degrees);
+    let map = crate::fixtures::statistics::test_environment_map().with_rotation(degrees);
     let scene = random_scene_full(5, vec![], Some(map));
     assert!(scene.env_select_prob > 0.0 && scene.env_select_prob < 1.0);
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();

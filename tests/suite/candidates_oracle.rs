@@ -15,7 +15,7 @@ use restir_pt::shading::shift::{primary_hit, ShiftParams, Vertex};
 use restir_pt::vk::{Buffer, BufferUsage};
 
 use crate::common::TestRng;
-use crate::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
+use crate::fixtures::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
 
 const ITEMS: usize = 4096;
 const IMAGE: u32 = 64;

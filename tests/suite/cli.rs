@@ -1,43 +1,8 @@
 //! The restir-pt binary: a render with its summary and JSON report, and bad input that must
 //! exit non-zero with one clear line on stderr (never a panic).
 
-use std::process::Command;
-
 use crate::common::{repo_path, temp_file};
-
-pub(crate) fn restir_pt(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_restir-pt"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// `restir-pt render` of the default scene with the path tracer at `width`×`height` and `spp`
-/// samples per pixel, then `extra` arguments.
-pub(crate) fn render_pt(width: u32, height: u32, spp: u32, extra: &[&str]) -> (i32, String, String) {
-    let (width, height, spp) = (width.to_string(), height.to_string(), spp.to_string());
-    let mut args = vec!["render", "--width", &width, "--height", &height, "--method", "pt", "--spp", &spp];
-    args.extend_from_slice(extra);
-    restir_pt(&args)
-}
-
-/// Exit code 1 and exactly one `error:` line that mentions every `needle`.
-pub(crate) fn assert_clean_failure(args: &[&str], needles: &[&str]) {
-    let (code, _, stderr) = restir_pt(args);
-    assert_eq!(code, 1, "{args:?} should fail; stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
-    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
-    assert_eq!(errors.len(), 1, "{args:?}: expected one error line, got: {stderr}");
-    for n in needles {
-        assert!(errors[0].contains(n), "{args:?}: error line {:?} does not mention {n:?}", errors[0]);
-    }
-}
+use crate::fixtures::cli::{assert_clean_failure, render_pt, restir_pt};
 
 #[test]
 fn cli_render_writes_images_summary_and_report() {

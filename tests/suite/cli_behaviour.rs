@@ -7,8 +7,8 @@ use glam::Vec3;
 use restir_pt::image_io::read_exr;
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 
-use crate::cli::{assert_clean_failure, render_pt, restir_pt};
 use crate::common::temp_file;
+use crate::fixtures::cli::{assert_clean_failure, render_pt, restir_pt};
 
 fn s(p: &std::path::Path) -> &str {
     p.to_str().unwrap()

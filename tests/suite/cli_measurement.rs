@@ -1,8 +1,8 @@
 //! The restir-pt binary's measurement commands (reference, profile, compare) and the check of
 //! every written image for non-finite pixels.
 
-use crate::cli::{assert_clean_failure, render_pt, restir_pt};
 use crate::common::temp_file;
+use crate::fixtures::cli::{assert_clean_failure, render_pt, restir_pt};
 
 /// `restir-pt reference` of cornell at 16x16 into `dir/ref.exr`.
 fn reference_16x16(dir: &std::path::Path, spp: u32) -> std::path::PathBuf {

@@ -102,7 +102,7 @@ fn default_environment_lights_an_open_asset_with_its_own_emitters_unless_env_non
 /// with a warning; a bad angle is one error line.
 #[test]
 fn default_environment_cli_env_rotation_turns_the_map_and_env_none_turns_it_off() {
-    use crate::cli::restir_pt;
+    use crate::fixtures::cli::restir_pt;
     use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
     let dir = crate::common::temp_file("placeholder", b"").parent().unwrap().join("env-rotation");
     std::fs::create_dir_all(&dir).unwrap();

@@ -9,7 +9,7 @@ use glam::Vec3;
 use restir_pt::scene::gltf_writer::{GltfBuilder, MaterialSpec, MeshData};
 use restir_pt::scene::{load_scene_from_bytes, Scene};
 
-use crate::alpha_images::{mean_and_error, render};
+use crate::fixtures::alpha_images::{mean_and_error, render};
 
 fn square_under_the_sky(material: MaterialSpec) -> Scene {
     let mut b = GltfBuilder::default();

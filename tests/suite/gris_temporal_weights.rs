@@ -25,7 +25,7 @@ use restir_pt::shading::shift::{
     inverse_hybrid, inverse_random_replay, inverse_reconnection, primary_hit, ShiftParams, ShiftResult, Vertex,
 };
 
-use crate::metal_box_scene::{metal_box, MetalBoxLights};
+use crate::fixtures::metal_box_scene::{metal_box, MetalBoxLights};
 
 const SIDE: u32 = 64;
 /// The temporal pass's confidence weights: the canonical M of one candidate; the history's

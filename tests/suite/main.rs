@@ -2,8 +2,8 @@
 //! device is present (lavapipe in CI) with the validation layer on; any message fails the test.
 
 mod common;
+mod fixtures;
 
-mod alpha_images;
 mod alpha_oracle;
 mod bench_cli;
 mod bsdf_oracle;
@@ -23,8 +23,6 @@ mod gris_temporal_weights;
 mod independent_renderer;
 mod layout;
 mod many_lights;
-mod metal_box_scene;
-mod normal_mapped_scene;
 mod punctual;
 mod ray_offset;
 mod real_scenes;
@@ -52,7 +50,6 @@ mod specular_layer;
 mod speed_accuracy;
 mod spirv_cache;
 mod startup;
-mod statistics;
 mod stress;
 mod surface_oracle;
 mod sweeps;

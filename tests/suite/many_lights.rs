@@ -14,7 +14,7 @@ use restir_pt::shading::lights::spot_falloff;
 use serde_json::{json, Value};
 
 use crate::common::{assert_clean, gpu};
-use crate::restir_unbiased::luminance;
+use crate::fixtures::unbiasedness::luminance;
 
 const ALBEDO: f32 = 0.5;
 

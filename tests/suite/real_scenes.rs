@@ -8,11 +8,7 @@ use restir_pt::scene::{
 };
 
 use crate::common::repo_path;
-
-/// A file of the malformed-input corpus (tests/data/bad/).
-pub(crate) fn corpus(name: &str) -> std::path::PathBuf {
-    repo_path("tests/data/bad").join(name)
-}
+use crate::fixtures::corpus;
 
 /// Each triangle as its three vertices rotated to start at the smallest, so that two lists of
 /// the same triangles with the same winding compare equal.

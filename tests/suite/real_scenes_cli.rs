@@ -4,9 +4,9 @@
 
 use glam::Vec3;
 
-use crate::cli::restir_pt;
 use crate::common::repo_path;
-use crate::real_scenes::corpus;
+use crate::fixtures::cli::restir_pt;
+use crate::fixtures::corpus;
 
 #[test]
 fn real_scenes_cli_prints_warnings_before_a_load_error_and_info_describes_defaulted_files() {

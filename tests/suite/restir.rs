@@ -9,7 +9,7 @@ use restir_pt::render::{PassKernel, PathTracer, RenderSettings, Restir, RestirSe
 use restir_pt::scene::{load_scene, Scene};
 
 use crate::common::{assert_clean, gpu, repo_path};
-use crate::restir_unbiased::{luminance, settings, FRAMES};
+use crate::fixtures::unbiasedness::{luminance, settings, FRAMES};
 
 /// The path tracer's sums add up in sample order however the samples are split into
 /// dispatches (whose sizes `render` picks from timing), so equal seeds give equal bits.

@@ -6,8 +6,8 @@
 
 use restir_pt::render::RestirSettings;
 
-use crate::metal_box_scene::{metal_box, MetalBoxLights};
-use crate::restir_unbiased::{check_unbiased_on, unbiasedness_failures, Unbiasedness, EVERY_CONFIGURATION, FRAMES};
+use crate::fixtures::metal_box_scene::{metal_box, MetalBoxLights};
+use crate::fixtures::unbiasedness::{check_unbiased_on, unbiasedness_failures, Unbiasedness, EVERY_CONFIGURATION, FRAMES};
 
 /// Independent chains per configuration: 8x8-pixel blocks of the metal faces then have standard
 /// errors of about 1% to 2% of their mean, so a 3% bias fails most of them.
@@ -66,7 +66,7 @@ fn restir_unbiased_sweep_bundled_scenes_and_roughness() {
     let mut failures = vec![];
     for bundled in restir_pt::scene::bundled_scenes::BUNDLED_SCENES {
         let name = bundled.file_name.trim_end_matches(".gltf");
-        let scene = crate::normal_mapped_scene::scene_named(name);
+        let scene = crate::fixtures::normal_mapped_scene::scene_named(name);
         failures.extend(
             unbiasedness_failures(test(name), &scene)
                 .into_iter()

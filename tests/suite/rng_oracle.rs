@@ -49,6 +49,6 @@ fn rng_uniform4_is_in_unit_interval_and_uniform() {
     }
     let expected = (draws as f64 * 4.0) / bins as f64;
     let chi2: f64 = counts.iter().map(|&c| (c as f64 - expected).powi(2) / expected).sum();
-    let critical = crate::sampling_statistics::chi_square_critical_1pct(bins - 1);
+    let critical = crate::fixtures::statistics::chi_square_critical_1pct(bins - 1);
     assert!(chi2 < critical, "chi2 {chi2:.1} >= {critical:.1}");
 }

@@ -12,14 +12,7 @@ use restir_pt::shading::lights::sample_light;
 use restir_pt::shading::sampling::{sample_cosine_hemisphere, sample_ggx_vndf, sample_triangle};
 
 use crate::common::TestRng;
-
-/// Upper 1% point of chi-square with `dof` degrees of freedom (Wilson-Hilferty; accurate to
-/// well under 1% for dof >= 10).
-pub fn chi_square_critical_1pct(dof: usize) -> f64 {
-    let k = dof as f64;
-    let z = 2.326_347_874;
-    k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3)
-}
+use crate::fixtures::statistics::{chi_square_critical_1pct, test_environment_map};
 
 /// Pearson's statistic after pooling bins whose expected count is below 5; returns (chi2, dof).
 fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize) {
@@ -150,7 +143,7 @@ fn sample_triangle_chi_square() {
 #[test]
 fn light_selection_chi_square_follows_its_pmf() {
     use restir_pt::shading::light_tree::{light_select, light_select_pmf};
-    let scene = crate::bvh_oracle::random_scene_with_punctual_lights(12);
+    let scene = crate::fixtures::random_scenes::random_scene_with_punctual_lights(12);
     assert!(scene.directional_count == 1 && scene.light_nodes.len() > 200);
     // Directional lights are not drawn: NEE takes each of them at every vertex, with
     // probability 1, beside the light drawn from the tree.
@@ -193,7 +186,7 @@ fn light_selection_chi_square_follows_its_pmf() {
 fn light_select_pmf_recomputes_the_sampled_pmf_exactly() {
     use restir_pt::shading::light_tree::{light_select, light_select_pmf};
     use restir_pt::shading::lights::{emitter_pdf, is_punctual_light, punctual_emitter_row};
-    let scene = crate::bvh_oracle::random_scene_with_punctual_lights(14);
+    let scene = crate::fixtures::random_scenes::random_scene_with_punctual_lights(14);
     let mut r = TestRng(81);
     let (mut drawn, mut triangles) = (0, 0);
     for i in 0..200_000 {
@@ -241,7 +234,7 @@ fn light_select_pmf_recomputes_the_sampled_pmf_exactly() {
 /// counted once per emitter), which uniform sphere sampling estimates independently.
 #[test]
 fn sample_light_pdf_is_consistent_with_solid_angle() {
-    let mut scene = crate::bvh_oracle::random_scene(13);
+    let mut scene = crate::fixtures::random_scenes::random_scene(13);
     scene.environment = Vec3::ZERO;
     scene.env_select_prob = 0.0;
     let p = Vec3::new(0.3, -0.2, 0.1);
@@ -281,25 +274,6 @@ fn sample_light_pdf_is_consistent_with_solid_angle() {
         (a - b).abs() < 4.0 * (va + vb).sqrt(),
         "light sampling {a:.5} vs sphere sampling {b:.5} sr"
     );
-}
-
-/// A 24 x 12 map with a sky gradient, a bright 2 x 1-texel sun and a black band, so that the
-/// luminance density is far from uniform.
-pub fn test_environment_map() -> restir_pt::scene::environment::EnvironmentMap {
-    let (w, h) = (24u32, 12u32);
-    let texels = (0..w * h)
-        .map(|k| {
-            let (i, j) = (k / w, k % w);
-            if i == 3 && (j == 7 || j == 8) {
-                Vec3::new(40.0, 35.0, 30.0)
-            } else if i == 9 {
-                Vec3::ZERO
-            } else {
-                Vec3::new(0.2, 0.3, 0.5) * (1.0 + i as f32 * 0.3) + Vec3::splat(0.05 * j as f32)
-            }
-        })
-        .collect();
-    restir_pt::scene::environment::EnvironmentMap::new(w, h, texels).unwrap()
 }
 
 /// Environment-map importance sampling: the texel counts of a million samples against

@@ -76,7 +76,7 @@ fn scale_addressed_layout_renders_the_images_of_the_bound_layout() {
 /// minutes of llvmpipe compilation on a cold shader cache.
 #[test]
 fn scale_addressed_surface_attributes_and_texels_render_the_images_of_the_bound_layout() {
-    let scene = crate::normal_mapped_scene::normal_mapped_box();
+    let scene = crate::fixtures::normal_mapped_scene::normal_mapped_box();
     assert!(!scene.surfaces.is_empty() && !scene.textures.texels.is_empty());
     assert_addressed_renders_as_bound(&scene, false);
 }

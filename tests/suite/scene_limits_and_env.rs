@@ -3,8 +3,8 @@
 
 use restir_pt::scene::{load_scene_reporting, LoadOptions};
 
-use crate::cli::restir_pt;
-use crate::real_scenes::corpus;
+use crate::fixtures::cli::restir_pt;
+use crate::fixtures::corpus;
 
 #[test]
 fn real_scenes_array_limit_is_checked_from_accessor_counts_before_loading() {
@@ -94,7 +94,7 @@ fn gltf_budget_counts_the_vertex_attributes_of_instanced_meshes() {
 
 #[test]
 fn real_scenes_env_file_loads_exr_and_hdr_and_renders_with_both_methods() {
-    let map = crate::sampling_statistics::test_environment_map();
+    let map = crate::fixtures::statistics::test_environment_map();
     let dir = crate::common::temp_file("placeholder", b"").parent().unwrap().join("env");
     std::fs::create_dir_all(&dir).unwrap();
     let exr = dir.join("sky.exr");

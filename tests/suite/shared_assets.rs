@@ -1,7 +1,7 @@
 //! The public glTF sample files under ../shared/assets (unmodified) render with both methods.
 
-use crate::cli::restir_pt;
 use crate::common::repo_path;
+use crate::fixtures::cli::restir_pt;
 
 /// Every .gltf under ../shared/assets (public sample files, unmodified), sorted; none if the
 /// folder is absent.

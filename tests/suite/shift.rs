@@ -6,102 +6,13 @@
 use std::collections::HashSet;
 
 use glam::Vec3;
-use restir_pt::scene::Scene;
 use restir_pt::shading::path_record::{
     record_length, record_lobe, record_nee_directional, record_nee_end, record_reconnection_index, PathRecord,
 };
 use restir_pt::shading::shift::*;
 
-use crate::common::TestRng;
-use crate::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
-
-const IMAGE: u32 = 64;
-const RADIUS: f32 = 20.0;
-pub(crate) const BASE_PATHS: usize = 10_000;
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Kind {
-    Reconnection,
-    RandomReplay,
-    Hybrid,
-}
-
-pub(crate) fn shift(kind: Kind, scene: &Scene, params: &ShiftParams, base: &PathRecord, camera: Vec3, y1: Vertex) -> ShiftResult {
-    match kind {
-        Kind::Reconnection => shift_reconnection(scene, params, base, camera, y1),
-        Kind::RandomReplay => shift_random_replay(scene, params, base, camera, y1),
-        Kind::Hybrid => shift_hybrid(scene, params, base, camera, y1),
-    }
-}
-
-pub(crate) fn inverse(kind: Kind, scene: &Scene, params: &ShiftParams, shifted: &PathRecord, camera: Vec3, x1: Vertex) -> ShiftResult {
-    match kind {
-        Kind::Reconnection => inverse_reconnection(scene, params, shifted, camera, x1),
-        Kind::RandomReplay => inverse_random_replay(scene, params, shifted, camera, x1),
-        Kind::Hybrid => inverse_hybrid(scene, params, shifted, camera, x1),
-    }
-}
-
-/// A base path in a random pixel of camera 0 and the primary hit of a neighbour within RADIUS.
-pub(crate) struct Case {
-    pub base: Path,
-    pub record: PathRecord,
-    pub y1: Vertex,
-}
-
-pub(crate) fn cases(scene: &Scene, seed: u64, count: usize) -> Vec<Case> {
-    let params = ShiftParams::for_scene(scene);
-    let mut r = TestRng(seed);
-    let mut out = Vec::with_capacity(count);
-    let mut attempts = 0;
-    while out.len() < count && attempts < 40 * count {
-        attempts += 1;
-        let (px, py) = (r.uniform() * IMAGE as f32, r.uniform() * IMAGE as f32);
-        let (qx, qy) = (
-            (px + (2.0 * r.uniform() - 1.0) * RADIUS).clamp(0.0, IMAGE as f32 - 0.01),
-            (py + (2.0 * r.uniform() - 1.0) * RADIUS).clamp(0.0, IMAGE as f32 - 0.01),
-        );
-        let (Some(x1), Some(y1)) = (
-            primary_hit(scene, 0, px, py, IMAGE, IMAGE),
-            primary_hit(scene, 0, qx, qy, IMAGE, IMAGE),
-        ) else {
-            continue;
-        };
-        let length = 2 + (r.uniform() * 5.0) as usize;
-        let nee_end = r.uniform() < 0.5;
-        // NEE's technique: the drawn light, or one of the directional lights it always takes.
-        let techniques = 1 + scene.directional_count;
-        let nee_directional = if nee_end {
-            ((r.uniform() * techniques as f32) as u32).min(techniques - 1)
-        } else {
-            0
-        };
-        let base = generate_path(
-            scene,
-            scene.cameras[0].position,
-            x1,
-            r.next_u64() as u32,
-            length,
-            nee_end,
-            nee_directional,
-        );
-        if let Some((base, record)) = base
-            .and_then(|b| Some((record_path(scene, &params, &b)?, b)))
-            .map(|(rec, b)| (b, rec))
-        {
-            out.push(Case { base, record, y1 });
-        }
-    }
-    // Scenes lit through a slit (veach-door) yield few paths that reach the light.
-    assert!(out.len() >= count / 10, "only {} of {count} base paths", out.len());
-    out
-}
-
-#[derive(Default, Debug)]
-struct Stats {
-    valid: usize,
-    failed: usize,
-}
+use crate::fixtures::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
+use crate::fixtures::shift_cases::{cases, inverse, shift, Kind, BASE_PATHS, IMAGE};
 
 /// Relative closeness of record values that the round trip recomputes.
 fn near(a: f32, b: f32, tol: f32) -> bool {
@@ -112,6 +23,12 @@ fn near(a: f32, b: f32, tol: f32) -> bool {
 /// contribution; the inverse is valid and returns the base record (its cached terms within
 /// 1e-4, its contribution within 1e-3) and the base's vertices (within 1e-4 of the scene's
 /// extent); the Jacobians are reciprocal within 1e-3. Failed shifts carry no value.
+#[derive(Default, Debug)]
+struct Stats {
+    valid: usize,
+    failed: usize,
+}
+
 fn check_round_trips(name: &str, kind: Kind) -> Stats {
     let scene = scene_named(name);
     let params = ShiftParams::for_scene(&scene);

@@ -10,8 +10,8 @@ use restir_pt::shading::path_record::PathRecord;
 use restir_pt::shading::shift::*;
 use restir_pt::vk::{Buffer, BufferUsage};
 
-use crate::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
-use crate::shift::{cases, inverse, shift, Kind, BASE_PATHS};
+use crate::fixtures::normal_mapped_scene::{scene_named, NORMAL_MAPPED_BOX};
+use crate::fixtures::shift_cases::{cases, inverse, shift, Kind, BASE_PATHS};
 
 /// One shift to run on both sides: the record and the target domain's primary vertex.
 struct Job {

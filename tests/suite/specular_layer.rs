@@ -11,7 +11,7 @@ use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, specular_layer_fresnel, DELTA_ALPHA, LOBE_NONE};
 
 use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
-use crate::sampling_statistics::chi_square_critical_1pct;
+use crate::fixtures::statistics::chi_square_critical_1pct;
 
 fn plastic(roughness: f32, ior: f32, specular: f32, specular_color: Vec3) -> Material {
     Material {

@@ -5,8 +5,8 @@
 use glam::Vec3;
 use restir_pt::metrics::{energy_ratio, flicker, rel_mse, rel_mse_trimmed, standard_error};
 
-use crate::cli::restir_pt;
 use crate::common::{repo_path, temp_file};
+use crate::fixtures::cli::restir_pt;
 
 #[test]
 fn metrics_rel_mse_energy_flicker_and_standard_error_match_hand_values() {

@@ -11,7 +11,7 @@ use restir_pt::scene::load_scene;
 use restir_pt::vk::{set_twin_compile, twin_compile_pays, Context, ContextOptions, TwinCompile, TWIN_COMPILE_ENV};
 
 use crate::common::{assert_clean, gpu, repo_path, temp_file};
-use crate::restir_unbiased::settings;
+use crate::fixtures::unbiasedness::settings;
 
 #[test]
 fn restir_kernels_for_cameras_are_those_the_frames_dispatch() {

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::cli::restir_pt;
 use crate::common::temp_file;
+use crate::fixtures::cli::restir_pt;
 
 fn ok(args: &[&str]) -> (String, String) {
     let (code, stdout, stderr) = restir_pt(args);

@@ -10,8 +10,8 @@ use restir_pt::scene::{load_scene, Scene};
 use restir_pt::shading::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
 use restir_pt::vk::{BindingSlot, Buffer, BufferUsage, Context, Kernel};
 
-use crate::bvh_oracle::random_scene;
 use crate::common::{assert_clean, close, gpu, TestRng};
+use crate::fixtures::random_scenes::random_scene;
 
 const PAIRS: usize = 12_000;
 
