@@ -233,3 +233,14 @@ pub fn temp_file(name: &str, contents: &[u8]) -> PathBuf {
     std::fs::write(&path, contents).unwrap();
     path
 }
+
+/// The kernels' MIS_MODE for a resampling MIS of the Rust estimator (`Uniform`, a negative
+/// control of the Rust tests only, has no kernel and maps to the generalized balance heuristic).
+pub fn mis_mode(mis: restir_pt::shading::gris::Mis) -> &'static str {
+    use restir_pt::render::ReuseMis;
+    match mis {
+        restir_pt::shading::gris::Mis::Pairwise => ReuseMis::Pairwise,
+        _ => ReuseMis::GeneralizedBalance,
+    }
+    .glsl_name()
+}

@@ -6,10 +6,9 @@
 //! offered candidates with zero weights and lost choices, as the reuse passes see them.
 
 use glam::{Vec3, Vec4};
-use restir_pt::render::ReuseMis;
 use restir_pt::shading::gris::{mis_weight, resampler_begin, resampler_finish, resampler_offer, Domains, Input, Mis};
 
-use crate::common::{close, gpu, run_oracle_with_defines, TestRng};
+use crate::common::{close, gpu, mis_mode, run_oracle_with_defines, TestRng};
 
 /// Inputs per resampling in the kernels (glsl/gris.glsl MAX_INPUTS).
 const MAX_INPUTS: usize = 9;
@@ -105,12 +104,7 @@ fn run_glsl(cases: &[Case], mis: Mis) -> Vec<Vec4> {
         .flat_map(|c| c.offers)
         .flat_map(|o| [o.contribution.extend(o.target), Vec4::new(o.weight, o.u, o.lost as u32 as f32, 0.0)])
         .collect();
-    let mode = if mis == Mis::Pairwise {
-        ReuseMis::Pairwise
-    } else {
-        ReuseMis::GeneralizedBalance
-    }
-    .glsl_name();
+    let mode = mis_mode(mis);
     let out = run_oracle_with_defines(
         &ctx,
         "oracle/gris_oracle.comp",

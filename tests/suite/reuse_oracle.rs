@@ -7,13 +7,12 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use restir_pt::render::ReuseMis;
 use restir_pt::shading::gris::{resampled_expectation, Domains, Input, Mis};
 use restir_pt::shading::path_record::PathRecord;
 use restir_pt::shading::resample_inputs::{resample_inputs, Reservoir, ReuseBridge, ReuseCounters};
 use restir_pt::shading::shift::ShiftResult;
 
-use crate::common::{assert_clean, close, gpu, run_oracle_with_defines, TestRng};
+use crate::common::{assert_clean, close, gpu, mis_mode, run_oracle_with_defines, TestRng};
 
 /// Inputs per resampling in the kernels (MAX_INPUTS of the shader interface).
 const MAX_INPUTS: usize = 9;
@@ -213,12 +212,7 @@ fn run_glsl(cases: &[Case], mis: Mis) -> Vec<ReuseOracleOutput> {
         .iter()
         .flat_map(|c| (0..MAX_INPUTS).map(|i| c.inputs.get(i).copied().unwrap_or_default()))
         .collect();
-    let mode = if mis == Mis::Pairwise {
-        ReuseMis::Pairwise
-    } else {
-        ReuseMis::GeneralizedBalance
-    }
-    .glsl_name();
+    let mode = mis_mode(mis);
     let out = run_oracle_with_defines(
         &ctx,
         "oracle/reuse_oracle.comp",
