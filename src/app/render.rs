@@ -184,13 +184,16 @@ impl RenderArgs {
     /// waits for the scene.
     fn check_before_device(&self, scene_path: &Path) -> Result<()> {
         let cannot_read = |e: std::io::Error| anyhow!("{}: cannot read the file: {e}", scene_path.display());
+        let file = std::fs::File::open(scene_path).map_err(cannot_read)?;
+        let file_bytes = file.metadata().map_err(cannot_read)?.len();
         let mut start = Vec::with_capacity(GLTF_START_BYTES as usize);
-        std::fs::File::open(scene_path)
-            .map_err(cannot_read)?
-            .take(GLTF_START_BYTES)
-            .read_to_end(&mut start)
-            .map_err(cannot_read)?;
-        restir_pt::scene::check_gltf_start(&start, start.len() < GLTF_START_BYTES as usize, scene_path)?;
+        file.take(GLTF_START_BYTES).read_to_end(&mut start).map_err(cannot_read)?;
+        restir_pt::scene::check_gltf_start(&start, file_bytes, scene_path)?;
+        for (flag, side) in [("--width", self.width), ("--height", self.height)] {
+            if side == Some(0) {
+                bail!("{flag} 0: the image must be at least 1 pixel on each side");
+            }
+        }
         let (width, height) = match (self.width, self.height) {
             (Some(w), Some(h)) => (w, h),
             // A valid stand-in: only spp and depth are checked.

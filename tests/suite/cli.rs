@@ -69,7 +69,7 @@ fn cli_bad_input_fails_with_one_clear_line() {
     assert_clean_failure(&["render", broken.to_str().unwrap()], &["broken.gltf", "invalid glTF"]);
     let truncated = temp_file("truncated.glb", b"glTF\x02\x00\x00\x00\xff\x00\x00\x00");
     assert_clean_failure(&["info", truncated.to_str().unwrap()], &["truncated.glb"]);
-    assert_clean_failure(&["render", "--width", "0"], &["resolution 0x256", "--width"]);
+    assert_clean_failure(&["render", "--width", "0"], &["--width 0", "at least 1 pixel"]);
     assert_clean_failure(&["bench", "--runs", "0", "--width", "8", "--height", "8"], &["--runs"]);
     assert_clean_failure(&["render", "--width", "100000", "--height", "100000"], &["too large"]);
     assert_clean_failure(&["render", "--method", "pt", "--spp", "0"], &["--spp"]);
@@ -88,11 +88,15 @@ fn cli_bad_input_fails_with_one_clear_line() {
 fn cli_bad_input_fails_before_the_device_opens() {
     let not_gltf = temp_file("notes.gltf", b"# restir-pt\nnot a scene\n");
     let empty = temp_file("empty.gltf", b"  \n");
+    let truncated = temp_file("cut.glb", b"glTF\x02\x00\x00\x00\xff\x00\x00\x00");
     for args in [
         &["render", "no/such/scene.gltf"][..],
         &["render", not_gltf.to_str().unwrap()],
         &["render", empty.to_str().unwrap()],
+        &["render", truncated.to_str().unwrap()],
         &["render", "--width", "100000", "--height", "100000"],
+        &["render", "--width", "0"],
+        &["render", "--height", "0"],
         &["render", "--method", "pt", "--spp", "0"],
         &["render", "--max-depth", "0"],
         &["render", "--out", "a.exr", "--png", "a.jpg"],

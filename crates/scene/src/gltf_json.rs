@@ -60,6 +60,23 @@ const GLB_HEADER_BYTES: usize = 12;
 /// A file's JSON and, for GLB, its binary chunk.
 type GltfChunks<'a> = (Cow<'a, [u8]>, Option<Vec<u8>>);
 
+/// Checks the length a GLB header (at the start of `start`) declares against the file's length
+/// `file_bytes`.
+fn check_glb_length(start: &[u8], file_bytes: u64, path: &Path) -> Result<()> {
+    let declared = start.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64);
+    match declared {
+        Some(length) if (GLB_HEADER_BYTES as u64..=file_bytes).contains(&length) => Ok(()),
+        Some(length) => bail!(problem(
+            path,
+            format!("truncated or corrupt GLB: the header declares {length} bytes, the file has {file_bytes}")
+        )),
+        None => bail!(problem(
+            path,
+            format!("truncated GLB: {file_bytes} bytes, less than its 12-byte header")
+        )),
+    }
+}
+
 /// Splits GLB into its JSON and binary chunks, or takes the bytes as glTF JSON. A GLB header whose
 /// length is shorter than the header itself makes the gltf crate's subtraction overflow (found by
 /// fuzzing), so it is checked first.
@@ -68,21 +85,7 @@ fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<GltfChunks<'a>> {
         // Borrowed: a .gltf with embedded data can be hundreds of megabytes.
         return Ok((Cow::Borrowed(bytes), None));
     }
-    let declared = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
-    match declared {
-        Some(length) if (GLB_HEADER_BYTES..=bytes.len()).contains(&length) => {}
-        Some(length) => bail!(problem(
-            path,
-            format!(
-                "truncated or corrupt GLB: the header declares {length} bytes, the file has {}",
-                bytes.len()
-            )
-        )),
-        None => bail!(problem(
-            path,
-            format!("truncated GLB: {} bytes, less than its 12-byte header", bytes.len())
-        )),
-    }
+    check_glb_length(bytes, bytes.len() as u64, path)?;
     let glb = gltf::Glb::from_slice(bytes).map_err(|e| problem(path, format!("invalid GLB: {e}")))?;
     Ok((Cow::Owned(glb.json.into_owned()), glb.bin.map(|b| b.into_owned())))
 }
@@ -102,14 +105,15 @@ fn not_gltf_reason(first_non_blank: Option<&u8>) -> Option<&'static str> {
     }
 }
 
-/// Checks that a file whose first bytes are `start` (all of it if `start` is the whole file,
-/// `whole`) can be glTF: the GLB magic, or JSON text. Fails with the loader's own message
-/// otherwise, so that a command can refuse the file before the slow work that comes before
-/// loading it (opening a device).
-pub fn check_gltf_start(start: &[u8], whole: bool, path: &Path) -> Result<()> {
+/// Checks that a file of `file_bytes` bytes whose first bytes are `start` can be glTF: GLB
+/// whose header declares a length the file has, or JSON text. Fails with the loader's own
+/// message otherwise, so that a command can refuse the file before the slow work that comes
+/// before loading it (opening a device).
+pub fn check_gltf_start(start: &[u8], file_bytes: u64, path: &Path) -> Result<()> {
     if start.starts_with(GLB_MAGIC) {
-        return Ok(());
+        return check_glb_length(start, file_bytes, path);
     }
+    let whole = start.len() as u64 >= file_bytes;
     let first = start.iter().find(|b| !b.is_ascii_whitespace());
     match not_gltf_reason(first) {
         // White space up to the end of a prefix says nothing yet.
