@@ -189,15 +189,18 @@ impl RenderArgs {
         let mut start = Vec::with_capacity(GLTF_START_BYTES as usize);
         file.take(GLTF_START_BYTES).read_to_end(&mut start).map_err(cannot_read)?;
         restir_pt::scene::check_gltf_start(&start, file_bytes, scene_path)?;
-        for (flag, side) in [("--width", self.width), ("--height", self.height)] {
-            if side == Some(0) {
-                bail!("{flag} 0: the image must be at least 1 pixel on each side");
-            }
-        }
         let (width, height) = match (self.width, self.height) {
             (Some(w), Some(h)) => (w, h),
-            // A valid stand-in: only spp and depth are checked.
-            _ => (1, 1),
+            // A side the camera completes is checked with the scene; a given one of 0 already.
+            (w, h) => {
+                for (flag, side) in [("--width", w), ("--height", h)] {
+                    if side == Some(0) {
+                        bail!("{flag} 0: the image must be at least 1 pixel on each side");
+                    }
+                }
+                // A valid stand-in: only spp and depth are checked.
+                (1, 1)
+            }
         };
         self.settings_of_size(width, height).validate_numbers()?;
         if let Some(restir) = self.restir_settings() {
