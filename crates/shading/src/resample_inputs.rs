@@ -103,6 +103,15 @@ pub fn resample_inputs<B: ReuseBridge>(
     let mut y = PathRecord::default();
     let (mut weight, mut own_target, mut jacobian, mut alive) = (0.0f32, 0.0f32, 1.0f32, false);
     let canonical = bridge.input_domain(0);
+    // The MIS weight reads only the confidences of these; the samples are the targets' row.
+    let inputs: Vec<Input<()>> = confidences
+        .iter()
+        .map(|&c| Input {
+            sample: (),
+            contribution_weight: 1.0,
+            confidence: c as f64,
+        })
+        .collect();
     for step in 0..n * n {
         let (i, l) = (step / n, step % n);
         let forward = l == 0;
@@ -156,14 +165,6 @@ pub fn resample_inputs<B: ReuseBridge>(
         }
         if l + 1 == n && alive {
             let p0 = targets_from[0];
-            let inputs: Vec<Input<()>> = confidences
-                .iter()
-                .map(|&c| Input {
-                    sample: (),
-                    contribution_weight: 1.0,
-                    confidence: c as f64,
-                })
-                .collect();
             let m = mis_weight(&TargetsFrom { targets: &targets_from }, &inputs, mis, i, ()) as f32;
             let w = m * p0 * weight * jacobian;
             if !w.is_finite() {
