@@ -24,23 +24,10 @@
 #define BSDF_SPECULAR 1
 #endif
 
-// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes are
-// ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
-const float DELTA_ALPHA = 1e-3;
-
-// Relative IORs this close to 1 (2^-16) are index-matched: the interface neither reflects nor
-// bends light, and the dielectric lobe is an exact pass-through whatever the roughness. Closer to
-// 1 the generalized half-vector wi * eta + wo, of length about |eta - 1|, is lost in rounding.
-const float INDEX_MATCHED_TOLERANCE = 1.0 / 65536.0;
+// DELTA_ALPHA, INDEX_MATCHED_TOLERANCE and the LOBE_* bits come from the generated header
+// (crates/interface/src/shader_interface.rs and path_record.rs say why they are what they are).
 
 bool index_matched(float eta) { return abs(eta - 1.0) <= INDEX_MATCHED_TOLERANCE; }
-
-const uint LOBE_NONE = 0u;
-const uint LOBE_DIFFUSE = 1u;
-const uint LOBE_CONDUCTOR = 2u;   // GGX reflection: the conductor and the non-metal specular layer
-const uint LOBE_DIELECTRIC = 4u;
-const uint LOBE_DELTA = 8u;
-const uint LOBE_TRANSMISSION = 16u;
 
 struct BsdfSample {
     vec3 wi;

@@ -12,8 +12,6 @@
 #define SCENE_ALPHA 0
 #endif
 
-const uint NO_HIT = 0xffffffffu;
-
 struct Hit {
     float t;
     uint triangle;   // NO_HIT on a miss
@@ -114,7 +112,6 @@ Hit trace_closest(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, 
 bool trace_occluded(vec3 o, vec3 d, float tmax) { return bvh_traverse(o, d, tmax, true).triangle != NO_HIT; }
 
 // Segment tests stop this fraction short of their (offset) end point.
-const float SEGMENT_EPSILON = 1e-4;
 
 // The shadow ray of the segment between surface points p (normal np, on triangle index tp) and q
 // (normal nq, on triangle index tq). Both ends are offset off their surfaces, each towards the

@@ -17,14 +17,6 @@
 #define TRAVERSAL_COUNTERS 0
 #endif
 
-const uint COUNTER_TRAVERSALS = 0u;
-const uint COUNTER_NODE_VISITS = 1u;
-const uint COUNTER_TRIANGLE_TESTS = 2u;
-const uint COUNTER_PATH_STEPS = 3u;
-const uint COUNTER_NODE_ITERATIONS = 4u;
-const uint COUNTER_TRIANGLE_ITERATIONS = 5u;
-const uint COUNTER_STEP_ITERATIONS = 6u;
-
 #if TRAVERSAL_COUNTERS
 uint profile_counts[COUNTER_COUNT] = uint[COUNTER_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u);
 #endif

@@ -10,17 +10,6 @@
 #include "loop_budget.glsl"
 #include "types.glsl"
 
-struct LightNode {
-    vec3 lo;
-    float intensity;   // sum of the largest radiant intensities below (luminance, W/sr)
-    vec3 hi;
-    float cos_theta_o; // the cone of normals around axis
-    vec3 axis;
-    float cos_theta_e; // how far beyond it the lights still emit
-    uint child;        // a leaf's emitter row; an interior node's second child (the first follows it)
-    uint flags;        // LIGHT_NODE_LEAF | LIGHT_NODE_TWO_SIDED
-};
-
 uvec4 emitter_words(uint row) {
     Emitter e = emitters[row];
     return uvec4(e.triangle, e.trail, floatBitsToUint(e.intensity), e.leaf);

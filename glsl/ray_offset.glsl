@@ -6,7 +6,6 @@
 #include "types.glsl"
 
 // 2^-17 = 128 unit roundoffs of f32 per unit of |v0| + |e1| + |e2| (see crates/shading-core/src/ray_offset.rs).
-const float RAY_OFFSET_SCALE = 1.0 / 131072.0;
 
 // The float next to x away from zero in direction s (s > 0: up, s < 0: down); x itself when
 // s == 0, x == 0 (the next float is denormal and may be flushed) or x is infinite.

@@ -13,28 +13,6 @@ struct Reservoir {
     float M;
 };
 
-struct ReservoirHead {
-    uint seed;
-    uint info;
-    uint lobes;
-    uint rc_triangle;
-    vec3 rc_pos;
-    float rc_pdf;
-    vec3 rc_next;
-    float rc_geometry;
-};
-
-struct ReservoirTail {
-    vec3 suffix;
-    float rc_pdf_after;
-    vec3 contribution;
-    uint rc_next_triangle;
-    float weight;       // W
-    float confidence;   // M
-    uint pad0;
-    uint pad1;
-};
-
 // The target function p̂: luminance of the path contribution. Every channel has a positive
 // weight, so p̂ > 0 wherever f is non-zero, as unbiased resampling requires.
 float target_function(vec3 contribution) {

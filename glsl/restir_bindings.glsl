@@ -15,45 +15,7 @@
 #include "loop_budget.glsl"
 #include "counters.glsl"
 
-// Which slots a pass reads and writes, and its random-number key.
-struct RestirPass {
-    uint in_slot;
-    uint out_slot;
-    uint prev_slot;
-    uint surface_slot;   // the current frame's surfaces; the previous frame's are the other slot
-    uint pass_seed;      // distinguishes the random choices of passes and rounds
-};
-
-layout(std430, set = 0, binding = RESTIR_BINDING_REUSE_PARAMS) readonly buffer ReuseParams {
-    vec4 prev_cam_position;  // the previous frame's camera, laid out like FrameParams' camera
-    vec4 prev_cam_right;
-    vec4 prev_cam_up;
-    vec4 prev_cam_forward;
-    float roughness_threshold;
-    float distance_threshold;
-    float m_cap;             // temporal confidence cap, as a multiple of the current M
-    float radius;            // spatial reuse radius in pixels
-    float normal_threshold;  // neighbours need dot(n, n') >= this
-    float depth_threshold;   // and |depth - depth'| <= this * depth
-    uint frame_index;
-    uint candidates;         // initial paths per pixel
-    uint neighbours;         // spatial neighbours per round
-    uint temporal_valid;     // 1 if the previous frame's reservoirs and surfaces exist
-    uint emission_rays;      // camera rays per reservoir for the emission seen directly
-    uint reservoirs;         // independent reservoirs per pixel (see reservoir_index)
-    uint emission_history;   // 1 if `direct` holds the running mean of the same camera pose
-    RestirPass passes[RESTIR_MAX_PASSES];
-};
-
-// A pixel's surface in one frame: the hit of the ray through its centre, from which temporal
-// and spatial reuse choose their inputs (restir_initial.comp says why not a candidate's hit).
-// One per pixel, shared by the pixel's reservoirs.
-struct Surface {
-    vec3 pos;
-    uint triangle;   // NO_HIT: the camera ray escaped
-    vec3 camera;
-    float depth;     // distance from the camera
-};
+layout(std430, set = 0, binding = RESTIR_BINDING_REUSE_PARAMS) readonly buffer ReuseParams { REUSE_PARAMS_FIELDS };
 
 layout(std430, set = 0, binding = RESTIR_BINDING_SURFACES0) buffer Surfaces0 { Surface surfaces0[]; };
 layout(std430, set = 0, binding = RESTIR_BINDING_SURFACES1) buffer Surfaces1 { Surface surfaces1[]; };
@@ -66,18 +28,7 @@ layout(std430, set = 0, binding = RESTIR_BINDING_RESERVOIR_TAILS2) buffer Reserv
 layout(std430, set = 0, binding = RESTIR_BINDING_DIRECT) buffer Direct { vec4 direct[]; };     // rgb: emission seen directly, w: frames averaged
 layout(std430, set = 0, binding = RESTIR_BINDING_ACCUM) buffer Accum { vec4 accum[]; };       // rgb: sum of frames, w: count
 layout(std430, set = 0, binding = RESTIR_BINDING_ACCUM_SQ) buffer AccumSq { vec4 accum_sq[]; };  // rgb: sum of squares
-layout(std430, set = 0, binding = RESTIR_BINDING_RESTIR_STATS) buffer RestirStats {
-    uint max_loop_iterations;
-    uint loop_budget_cut_groups;
-    uint shifts_attempted;
-    uint shifts_failed;
-    uint nonfinite_weights;
-    uint candidates_dropped;
-    uint nonfinite_pixels;
-    uint reuse_traversals;     // traversals started by the reuse kernels, all inside shifts
-    uint shift_subgroup_runs;  // runs of the shift code by a subgroup, whichever lanes shift
-    uint subgroup_size;        // lanes of a subgroup (llvmpipe: one SIMD group)
-};
+layout(std430, set = 0, binding = RESTIR_BINDING_RESTIR_STATS) buffer RestirStats { RESTIR_STATS_FIELDS };
 // rgb: the expectation of f(Y) W_Y over the last resampling's choice (see Resampler), written by
 // whichever pass last resampled the pixel.
 layout(std430, set = 0, binding = RESTIR_BINDING_EXPECTATION) buffer Expectation { vec4 expectation[]; };

@@ -4,6 +4,9 @@
 #ifndef RNG_GLSL
 #define RNG_GLSL
 
+// The streams used at each vertex (STREAM_*) are in the generated header.
+#include "shader_interface.glsl"
+
 // The 4D permuted congruential hash of Jarzynski and Olano (JCGT 2020).
 uvec4 pcg4d(uvec4 v) {
     v = v * 1664525u + 1013904223u;
@@ -27,12 +30,5 @@ vec4 rng_uniform4(uint seed, uint vertex, uint stream) {
     uvec4 h = pcg4d(uvec4(seed, vertex, stream, 0x68e31da4u));
     return vec4(u32_to_unit_float(h.x), u32_to_unit_float(h.y), u32_to_unit_float(h.z), u32_to_unit_float(h.w));
 }
-
-// Streams used at each vertex.
-const uint STREAM_CAMERA = 0u;
-const uint STREAM_BSDF = 1u;
-const uint STREAM_LIGHT = 2u;
-const uint STREAM_RESAMPLE = 3u;  // ReSTIR's choices among candidates, keyed by a pass seed
-const uint STREAM_DIRECTIONAL = 4u;  // ReSTIR's choice of directional light k's NEE candidate: + k
 
 #endif

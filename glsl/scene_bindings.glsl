@@ -8,22 +8,7 @@
 
 // A read-only storage buffer, not a uniform buffer: lavapipe compiles a kernel again for every
 // new value of a uniform or push constant that steers its control flow (crates/vk/src/buffer.rs).
-layout(std430, set = 0, binding = SCENE_BINDING_FRAME_PARAMS) readonly buffer FrameParams {
-    vec4 cam_position;   // w: tan(yfov / 2)
-    vec4 cam_right;      // w: aspect ratio (width / height)
-    vec4 cam_up;
-    vec4 cam_forward;
-    vec4 scene_env;      // rgb: constant environment radiance, w: probability NEE picks it
-    uint width;
-    uint height;
-    uint sample_offset;
-    uint samples_per_dispatch;
-    uint max_depth;
-    uint render_seed;
-    uint flags;
-    uint emitter_count;
-};
-const uint FLAG_RUSSIAN_ROULETTE = 1u;
+layout(std430, set = 0, binding = SCENE_BINDING_FRAME_PARAMS) readonly buffer FrameParams { FRAME_PARAMS_FIELDS };
 
 // On CPU devices small scenes are bound as uniform buffers, whose loads llvmpipe handles much
 // faster than storage-buffer loads; the array sizes are then compile-time constants.

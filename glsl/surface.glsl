@@ -17,8 +17,6 @@ struct SurfaceHit {
     vec3 color;         // interpolated COLOR_0 (linear RGB); 1 where the vertices have none
 };
 
-const float SURFACE_MIN_LENGTH_SQUARED = 1e-12;
-
 // Barycentrics (b1, b2) of point p (on or near the triangle's plane) in tri: the least-squares
 // solution of p - v0 = b1 e1 + b2 e2.
 vec2 triangle_bary(Triangle tri, vec3 p) {

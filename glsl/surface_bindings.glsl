@@ -22,50 +22,6 @@
 #define SURFACE_BINDING 0
 #endif
 
-// One triangle's vertex attributes, in the triangles' order (scene space).
-struct TriangleSurface {
-    vec4 normal[3];     // xyz: vertex normal (zero: none, the face normal is used); w: COLOR_0 bits
-    vec4 tangent[3];    // xyz: vertex tangent, w: handedness (bitangent = w * cross(n, t))
-    vec4 uv[3];         // xy: TEXCOORD_0, zw: TEXCOORD_1
-};
-
-// A texture's place in the texel array and its sampler.
-struct TextureHeader {
-    uint width;
-    uint height;
-    uint offset;        // index of its first texel (row-major from the image's top row)
-    uint sampler_bits;       // wrap S (bits 0-1), wrap T (bits 2-3): TEXTURE_WRAP_*; bit 4: nearest
-};
-const uint TEXTURE_WRAP_REPEAT = 0u;
-const uint TEXTURE_WRAP_CLAMP = 1u;
-const uint TEXTURE_WRAP_MIRROR = 2u;
-const uint TEXTURE_NEAREST = 16u;
-const uint NO_TEXTURE = 0xffffffffu;
-
-// A material's use of one texture: uv' = (dot(u_row, (uv, 1)), dot(v_row, (uv, 1))) of its
-// coordinate set (KHR_texture_transform folded into the two rows).
-struct TextureSlot {
-    vec3 u_row;
-    uint texture_index; // NO_TEXTURE: none
-    vec3 v_row;
-    uint texcoord;      // 0 or 1
-};
-
-// The textures of one material (parallel to `materials`).
-struct MaterialTextures {
-    TextureSlot base_color;     // sRGB; alpha in a
-    TextureSlot metal_rough;    // linear; B metallic, G roughness
-    TextureSlot emissive;       // sRGB
-    TextureSlot normal;         // linear; tangent-space normal
-    float normal_scale;
-    float alpha_cutoff;
-    uint alpha_mode;            // ALPHA_*
-    float base_alpha;           // baseColorFactor's alpha
-};
-const uint ALPHA_OPAQUE = 0u;
-const uint ALPHA_MASK = 1u;
-const uint ALPHA_BLEND = 2u;
-
 #ifndef SCENE_ADDRESSED
 #define SCENE_ADDRESSED 0
 #endif

@@ -62,7 +62,7 @@ pub mod metrics;
 pub mod reference_shard;
 pub mod render;
 
-pub use restir_pt_interface::{gpu_types, shader_interface};
+pub use restir_pt_interface::{glsl_record, gpu_types, oracle_types, shader_interface, surface_types};
 pub use restir_pt_scene as scene;
 pub use restir_pt_shading as shading;
 pub use restir_pt_vk as vk;

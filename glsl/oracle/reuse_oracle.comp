@@ -19,27 +19,7 @@ struct Domain {
 
 // Per item: the number of inputs and the seed of the choice.
 layout(std430, set = 0, binding = 0) readonly buffer Cases { uvec2 cases[]; };
-// Per item and input (MAX_INPUTS each): ReuseToyInput in tests/suite/reuse_oracle.rs.
-struct ReuseToyInput {
-    float x;
-    float weight;       // W
-    float confidence;   // c
-    uint domain;
-};
 layout(std430, set = 0, binding = 1) readonly buffer Inputs { ReuseToyInput toy_inputs[]; };
-// Per item: ReuseOracleOutput in tests/suite/reuse_oracle.rs.
-struct ReuseOracleOutput {
-    vec3 expected;
-    float weight;        // W of the result
-    float confidence;    // M of the result
-    float chosen_x;
-    int chosen_input;    // -1: none
-    uint chosen_domain;
-    uint shifts_failed;
-    uint nonfinite_weights;
-    uint pad0;
-    uint pad1;
-};
 layout(std430, set = 0, binding = 2) writeonly buffer Outputs { ReuseOracleOutput outputs[]; };
 layout(push_constant) uniform Push { uint count; };
 
@@ -120,5 +100,5 @@ void main() {
     Reservoir r = resample_inputs(n, cases[item].y, expected);
     bool chose = r.W > 0.0;
     outputs[item] = ReuseOracleOutput(expected, r.W, r.M, r.record.rc_pos.x, chose ? int(r.record.seed) : -1,
-                                      r.record.info, local_shifts_failed, local_nonfinite_weights, 0u, 0u);
+                                      r.record.info, local_shifts_failed, local_nonfinite_weights, uvec2(0u));
 }

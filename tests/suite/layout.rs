@@ -1,18 +1,20 @@
-//! Host structs against the GLSL layout: member offsets and array strides read from the SPIR-V
+//! Records against their GLSL layout: member offsets and array strides read from the SPIR-V
 //! that glslang produced (OpMemberDecorate Offset, OpDecorate ArrayStride) must equal the
-//! `#[repr(C)]` offsets and sizes of the Rust twins in crates/interface/src/gpu_types.rs; and every kernel's
-//! descriptor bindings (number, block name, descriptor type) must be those that
-//! crates/interface/src/shader_interface.rs declares.
+//! `#[repr(C)]` offsets and sizes of every record `shader_interface::records` lists, in a
+//! kernel written here that declares them all and in the kernels that bind them; no GLSL file
+//! declares a record or a generated constant by hand, and no Rust record escapes the
+//! declaration that generates its GLSL; and every kernel's descriptor bindings (number, block
+//! name, descriptor type) must be those that crates/interface/src/shader_interface.rs declares.
 
 use std::collections::HashMap;
 
-use restir_pt::gpu_types::{
-    BvhNode, Emitter, FrameParams, Material, ReservoirHead, ReservoirTail, RestirPass, RestirStats, ReuseParams, Surface, Triangle,
-};
+use restir_pt::glsl_record::{upper_snake, GlslDeclaration};
 use restir_pt::render::{PassKernel, ReuseMis, ShiftKind};
-use restir_pt::shader_interface::{PathTraceBinding, RestirBinding, SceneBinding, SurfaceBinding};
-use restir_pt::shading::path_record::PathRecord;
-use restir_pt::vk::{check_bindings, compile_kernel, reflect_bindings, Binding, BindingFamilyExt, BindingSlot};
+use restir_pt::shader_interface::{records, PathTraceBinding, RestirBinding, SceneBinding, SurfaceBinding, GLSL_HEADER_NAME};
+use restir_pt::vk::{
+    check_bindings, compile_glsl_source, compile_kernel, glsl_source, reflect_bindings, Binding, BindingFamilyExt, BindingSlot,
+    GLSL_SOURCES,
+};
 
 const OP_NAME: u32 = 5;
 const OP_MEMBER_NAME: u32 = 6;
@@ -64,29 +66,39 @@ fn reflect(spirv: &[u32]) -> Reflection {
     r
 }
 
-macro_rules! rust_fields {
-    ($t:ty: $($f:ident),*) => {
-        (stringify!($t), std::mem::size_of::<$t>(), vec![$((stringify!($f).to_string(), std::mem::offset_of!($t, $f) as u32)),*])
-    };
-}
-
-/// (struct name, size in bytes, (field, offset) pairs) of a Rust twin.
+/// (struct name, size in bytes, (field, offset) pairs) of a Rust record.
 type StructLayout = (&'static str, usize, Vec<(String, u32)>);
 
+/// The layouts of the records `names`, read from their declarations.
+fn layouts(names: &[&str]) -> Vec<StructLayout> {
+    let all = records();
+    names
+        .iter()
+        .map(|name| {
+            let r = all
+                .iter()
+                .find(|r| r.name == *name)
+                .unwrap_or_else(|| panic!("{name} is not a declared record"));
+            (
+                r.name,
+                r.size,
+                r.fields.iter().map(|f| (f.name.to_string(), f.offset as u32)).collect(),
+            )
+        })
+        .collect()
+}
+
 fn scene_structs() -> Vec<StructLayout> {
-    vec![
-        rust_fields!(Material: base_color, metallic, emission, roughness, transmission, ior, flags, specular, specular_color, pad),
-        rust_fields!(Triangle: v0, material, e1, emitter, e2, alpha_tested),
-        rust_fields!(BvhNode: lo, skip, hi, leaf),
-        rust_fields!(Emitter: triangle, trail, intensity, leaf),
-        rust_fields!(FrameParams: cam_position, cam_right, cam_up, cam_forward, scene_env, width, height, sample_offset,
-            samples_per_dispatch, max_depth, render_seed, flags, emitter_count),
-    ]
+    layouts(&["Material", "Triangle", "BvhNode", "Emitter", "FrameParams"])
 }
 
 fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<StructLayout>) -> usize {
     let spirv = compile_kernel(kernel, defines).expect("kernel compiles");
-    let r = reflect(&spirv);
+    check_spirv_layout(kernel, &spirv, structs)
+}
+
+fn check_spirv_layout(kernel: &str, spirv: &[u32], structs: Vec<StructLayout>) -> usize {
+    let r = reflect(spirv);
     let mut checked = 0;
     for (name, size, fields) in structs {
         // glslang also emits an undecorated copy of each struct for locals; only the copies with
@@ -117,14 +129,7 @@ fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<StructLayou
 /// The records of set 1 (glsl/surface_bindings.glsl): per-triangle attributes, whose normals'
 /// w carries the packed COLOR_0 (`surface::pack_vertex_color`), and the texture records.
 fn surface_structs() -> Vec<StructLayout> {
-    use restir_pt::shading::surface::TriangleSurface;
-    use restir_pt::shading::texture::{MaterialTextures, TextureHeader, TextureSlot};
-    vec![
-        rust_fields!(TriangleSurface: normal, tangent, uv),
-        rust_fields!(TextureHeader: width, height, offset, sampler_bits),
-        rust_fields!(TextureSlot: u_row, texture_index, v_row, texcoord),
-        rust_fields!(MaterialTextures: base_color, metal_rough, emissive, normal, normal_scale, alpha_cutoff, alpha_mode, base_alpha),
-    ]
+    layouts(&["TriangleSurface", "TextureHeader", "TextureSlot", "MaterialTextures"])
 }
 
 #[test]
@@ -148,28 +153,153 @@ fn gpu_types_match_glsl_layout_in_storage_and_uniform_bindings() {
 
 #[test]
 fn path_record_matches_glsl_layout() {
-    let record = vec![
-        rust_fields!(PathRecord: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry, suffix,
-        rc_pdf_after, contribution, rc_next_triangle),
-    ];
+    let record = layouts(&["PathRecord"]);
     assert_eq!(check_layout("oracle/shift_oracle.comp", &[("ORACLE_SHIFT", "0")], record), 1);
 }
 
 #[test]
 fn restir_structs_match_glsl_layout() {
-    let structs = vec![
-        rust_fields!(ReuseParams: prev_cam_position, prev_cam_right, prev_cam_up, prev_cam_forward, roughness_threshold,
-            distance_threshold, m_cap, radius, normal_threshold, depth_threshold, frame_index, candidates, neighbours,
-            temporal_valid, emission_rays, reservoirs, emission_history, passes),
-        rust_fields!(Surface: pos, triangle, camera, depth),
-        rust_fields!(ReservoirHead: seed, info, lobes, rc_triangle, rc_pos, rc_pdf, rc_next, rc_geometry),
-        rust_fields!(ReservoirTail: suffix, rc_pdf_after, contribution, rc_next_triangle, weight, confidence, pad0, pad1),
-        rust_fields!(RestirStats: max_loop_iterations, loop_budget_cut_groups, shifts_attempted, shifts_failed, nonfinite_weights,
-            candidates_dropped, nonfinite_pixels, reuse_traversals, shift_subgroup_runs, subgroup_size),
-        rust_fields!(RestirPass: in_slot, out_slot, prev_slot, surface_slot, pass_seed),
-    ];
+    let structs = layouts(&[
+        "ReuseParams",
+        "Surface",
+        "ReservoirHead",
+        "ReservoirTail",
+        "RestirStats",
+        "RestirPass",
+    ]);
     assert_eq!(check_layout("restir_spatial.comp", &[], structs), 6);
-    assert_eq!(std::mem::size_of::<ReservoirHead>() + std::mem::size_of::<ReservoirTail>(), 96);
+    let halves: usize = layouts(&["ReservoirHead", "ReservoirTail"]).iter().map(|(_, size, _)| size).sum();
+    assert_eq!(halves, 96);
+}
+
+/// A kernel that declares every record: an array of each struct record and each block record as
+/// its block, every one read so that glslang keeps it.
+fn every_record_kernel() -> String {
+    let mut declarations = String::new();
+    let mut reads = String::new();
+    for (i, r) in records().iter().enumerate() {
+        let binding = i + 1;
+        match r.declaration {
+            GlslDeclaration::Struct => {
+                declarations += &format!(
+                    "layout(std430, set = 0, binding = {binding}) readonly buffer Records{i} {{ {} items{i}[]; }};\n",
+                    r.name
+                );
+                reads += &format!("    sink[{i}] = uint(items{i}.length());\n");
+            }
+            GlslDeclaration::BlockFields => {
+                let word = r
+                    .fields
+                    .iter()
+                    .find(|f| f.glsl.starts_with("uint "))
+                    .expect("a block record has a uint member");
+                declarations += &format!(
+                    "layout(std430, set = 0, binding = {binding}) readonly buffer {} {{ {}_FIELDS }} block{i};\n",
+                    r.name,
+                    upper_snake(r.name)
+                );
+                reads += &format!("    sink[{i}] = block{i}.{};\n", word.name);
+            }
+        }
+    }
+    format!(
+        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"{GLSL_HEADER_NAME}\"\n\
+         layout(local_size_x = 1) in;\n\
+         layout(std430, set = 0, binding = 0) writeonly buffer Sink {{ uint sink[]; }};\n{declarations}\
+         void main() {{\n{reads}}}\n"
+    )
+}
+
+/// Every record of `shader_interface::records`, struct or block, nested or not, has glslang's
+/// std430 offsets and stride; a record left out of the list is caught by the next test.
+#[test]
+fn every_declared_record_matches_glslang_layout() {
+    let all = records();
+    let spirv = compile_glsl_source("every_record.comp", &every_record_kernel(), &[]).expect("the generated records compile");
+    let names: Vec<&str> = all.iter().map(|r| r.name).collect();
+    assert_eq!(check_spirv_layout("every_record.comp", &spirv, layouts(&names)), all.len());
+}
+
+fn repository_files(dir: &std::path::Path, ext: &str, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("readable folder").flatten() {
+        let path = entry.path();
+        let name = entry.file_name();
+        if path.is_dir() {
+            if !matches!(name.to_str(), Some("target" | ".git" | ".venv" | "node_modules")) {
+                repository_files(&path, ext, out);
+            }
+        } else if path.extension().is_some_and(|e| e == ext) {
+            out.push(path);
+        }
+    }
+}
+
+/// Records and constants are written once, in Rust: no GLSL source declares a struct of a
+/// record's name, a block of a block record's name without its generated member list, or a
+/// constant the header generates; and no Rust source outside the `gpu_record!` macro writes
+/// `#[repr(C)]`, so every record shared with GLSL is a declared one.
+#[test]
+fn records_and_constants_are_declared_only_in_rust() {
+    let all = records();
+    let header = glsl_source(GLSL_HEADER_NAME).expect("the generated header is embedded");
+    let constants: Vec<&str> = header
+        .lines()
+        .filter_map(|l| l.strip_prefix("const ")?.split_whitespace().nth(1))
+        .collect();
+    assert!(constants.len() >= 50 && constants.contains(&"NO_HIT"), "{constants:?}");
+    let mut problems = Vec::new();
+    for (name, text) in GLSL_SOURCES.iter().filter(|(n, _)| *n != GLSL_HEADER_NAME) {
+        for line in text.lines().map(str::trim) {
+            for r in &all {
+                let by_hand = match r.declaration {
+                    GlslDeclaration::Struct => line.starts_with(&format!("struct {} ", r.name)),
+                    GlslDeclaration::BlockFields => {
+                        line.contains(&format!("buffer {} ", r.name)) && !line.contains(&format!("{}_FIELDS", upper_snake(r.name)))
+                    }
+                };
+                if by_hand {
+                    problems.push(format!("glsl/{name}: {line}"));
+                }
+            }
+            if let Some(rest) = line.strip_prefix("const ").or_else(|| line.strip_prefix("#define ")) {
+                let words: Vec<&str> = rest.split_whitespace().collect();
+                if words.iter().take(2).any(|w| constants.contains(w)) {
+                    problems.push(format!("glsl/{name}: {line}"));
+                }
+            }
+        }
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut rust = Vec::new();
+    repository_files(root, "rs", &mut rust);
+    assert!(rust.len() > 50, "the repository's Rust sources are found: {}", rust.len());
+    let repr_c = "#[repr(".to_string() + "C)]";
+    for path in rust.iter().filter(|p| !p.ends_with("crates/interface/src/glsl_record.rs")) {
+        let text = std::fs::read_to_string(path).expect("readable source");
+        if text.lines().any(|l| l.trim() == repr_c) {
+            problems.push(format!("{}: a `{repr_c}` struct not declared by gpu_record!", path.display()));
+        }
+    }
+    assert!(problems.is_empty(), "written by hand:\n{}", problems.join("\n"));
+}
+
+/// glsl/generated/ holds the header the build generates, for GLSL tools (`glslangValidator -I
+/// glsl/generated`), which cannot run the build script. `RESTIR_PT_BLESS=1` rewrites it.
+#[test]
+fn the_header_copy_for_glsl_tools_is_current() {
+    let header = glsl_source(GLSL_HEADER_NAME).expect("the generated header is embedded");
+    let copy = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("glsl/generated")
+        .join(GLSL_HEADER_NAME);
+    if std::env::var_os("RESTIR_PT_BLESS").is_some() {
+        std::fs::write(&copy, header).expect("glsl/generated/ is writable");
+    }
+    let text = std::fs::read_to_string(&copy).unwrap_or_default();
+    assert!(
+        text == header,
+        "{} differs from the header the build generated: run `RESTIR_PT_BLESS=1 cargo test --release --test suite the_header_copy` and commit it",
+        copy.display()
+    );
 }
 
 /// The uniform-buffer variant's defines, with small array sizes.

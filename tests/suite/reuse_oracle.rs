@@ -5,8 +5,8 @@
 //! the twin's f(Y) W_Y against the integral. Up to 9 inputs per resampling, from the canonical
 //! domain (identity shifts), from domains whose shifts fail on part of them, and empty ones.
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use restir_pt::oracle_types::{ReuseOracleOutput, ReuseToyInput};
 use restir_pt::shading::gris::{resampled_expectation, Domains, Input, Mis};
 use restir_pt::shading::path_record::PathRecord;
 use restir_pt::shading::resample_inputs::{resample_inputs, Reservoir, ReuseBridge, ReuseCounters};
@@ -14,40 +14,9 @@ use restir_pt::shading::shift::ShiftResult;
 
 use crate::common::{assert_clean, close, gpu, mis_mode, run_oracle_with_defines, TestRng};
 
-/// Inputs per resampling in the kernels (MAX_INPUTS of the shader interface).
-const MAX_INPUTS: usize = 9;
+/// Inputs per resampling in the kernels.
+const MAX_INPUTS: usize = restir_pt::shader_interface::MAX_INPUTS as usize;
 const CASES: usize = 4096;
-
-/// One input of a toy resampling (GLSL `ReuseToyInput`, 16 bytes, std430).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
-struct ReuseToyInput {
-    /// The sample's position in its domain.
-    x: f32,
-    /// W_X: 1 / pdf(x), 0 for an empty reservoir.
-    weight: f32,
-    /// c.
-    confidence: f32,
-    /// 0 (canonical), 1 or 2.
-    domain: u32,
-}
-
-/// What the oracle kernel writes per resampling (GLSL `ReuseOracleOutput`, 48 bytes, std430).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct ReuseOracleOutput {
-    expected: [f32; 3],
-    weight: f32,
-    confidence: f32,
-    chosen_x: f32,
-    chosen_input: i32,
-    chosen_domain: u32,
-    shifts_failed: u32,
-    nonfinite_weights: u32,
-    pad: [u32; 2],
-}
-
-const _: () = assert!(std::mem::size_of::<ReuseOracleOutput>() == 48);
 
 struct Case {
     seed: u32,

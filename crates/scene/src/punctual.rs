@@ -4,21 +4,23 @@
 use anyhow::{bail, Result};
 use glam::{DMat4, DVec3, Vec3};
 
-use restir_pt_interface::gpu_types::Emitter;
+use restir_pt_interface::gpu_types::{Emitter, PUNCTUAL_DIRECTIONAL, PUNCTUAL_POINT, PUNCTUAL_SPOT};
 
 use super::gltf_loader::{problem, Loader};
 use super::luminance;
 
-/// The kind of a punctual light; the values are those of glsl/types.glsl.
+/// The kind of a punctual light; the values are the interface's `PUNCTUAL_*` constants, which
+/// the kernels read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
 pub enum PunctualKind {
     /// Emits the same intensity in every direction from `position`.
-    Point = 0,
+    Point = PUNCTUAL_POINT,
     /// A point light restricted to a cone around `direction`, with a smooth edge between the inner
     /// and outer angles (a hard edge where they are equal, as Blender writes a spot of blend 0).
-    Spot = 1,
+    Spot = PUNCTUAL_SPOT,
     /// Parallel light along `direction` from infinitely far away, e.g. the sun.
-    Directional = 2,
+    Directional = PUNCTUAL_DIRECTIONAL,
 }
 
 /// A punctual light in scene coordinates (world space moved by -`Scene::origin`). Radiometry:

@@ -6,37 +6,15 @@ use glam::{Vec3, Vec4};
 use std::f32::consts::PI;
 
 use restir_pt_interface::gpu_types::Material;
+pub use restir_pt_interface::path_record::{LOBE_CONDUCTOR, LOBE_DELTA, LOBE_DIELECTRIC, LOBE_DIFFUSE, LOBE_NONE, LOBE_TRANSMISSION};
+pub use restir_pt_interface::shader_interface::{DELTA_ALPHA, INDEX_MATCHED_TOLERANCE};
 
 use crate::sampling::{build_onb, pdf_cosine_hemisphere, sample_cosine_hemisphere, sample_ggx_vndf, to_local, to_world, INV_PI};
-
-/// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes
-/// are ill-conditioned in f32 (pdf errors grow like epsilon / alpha).
-pub const DELTA_ALPHA: f32 = 1e-3;
-
-/// Relative IORs this close to 1 (2⁻¹⁶) are index-matched: the interface neither reflects nor
-/// bends light, and the dielectric lobe is an exact pass-through whatever the roughness. Closer
-/// to 1 the generalized half-vector wi η + wo, of length about |η − 1|, is lost in rounding.
-pub const INDEX_MATCHED_TOLERANCE: f32 = 1.0 / 65536.0;
 
 /// Twin of GLSL `index_matched`: whether relative IOR `eta` is within rounding of 1.
 pub fn index_matched(eta: f32) -> bool {
     (eta - 1.0).abs() <= INDEX_MATCHED_TOLERANCE
 }
-
-/// Lobe bits of a sampled direction ([`BsdfSample::lobe`], `PathRecord::lobes`); shared with
-/// glsl/bsdf.glsl. No lobe: a failed sample, or a vertex whose successor NEE chose.
-pub const LOBE_NONE: u32 = 0;
-/// The Lambertian base of the non-metal part.
-pub const LOBE_DIFFUSE: u32 = 1;
-/// GGX reflection: the conductor and the non-metal specular layer.
-pub const LOBE_CONDUCTOR: u32 = 2;
-/// The dielectric interface (transmission part), reflected or refracted.
-pub const LOBE_DIELECTRIC: u32 = 4;
-/// Set with another bit when that lobe was a perfect (delta) specular: `pdf` is then a discrete
-/// probability, not a density, and the direction cannot be reached by another technique.
-pub const LOBE_DELTA: u32 = 8;
-/// Set with [`LOBE_DIELECTRIC`] when the direction crossed the surface (refraction).
-pub const LOBE_TRANSMISSION: u32 = 16;
 
 /// A direction sampled from the BSDF (twin of GLSL `BsdfSample`, glsl/bsdf.glsl). A failed
 /// sample has zero `weight`, zero `pdf` and [`LOBE_NONE`].

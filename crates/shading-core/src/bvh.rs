@@ -8,8 +8,7 @@ use restir_pt_interface::gpu_types::{BvhNode, Triangle};
 use crate::alpha::AlphaScene;
 use crate::ray_offset::offset_ray_origin;
 
-/// The triangle index of a miss (and of an escaped path vertex); shared with glsl/bvh.glsl.
-pub const NO_HIT: u32 = u32::MAX;
+pub use restir_pt_interface::gpu_types::NO_HIT;
 
 /// A ray's hit (twin of GLSL `Hit`, glsl/bvh.glsl).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -122,8 +121,7 @@ pub fn trace_occluded(nodes: &[BvhNode], triangles: &[Triangle], o: Vec3, d: Vec
     bvh_traverse(nodes, triangles, None, o, d, tmax, true).triangle != NO_HIT
 }
 
-/// Segment tests stop this fraction short of their (offset) end point.
-pub const SEGMENT_EPSILON: f32 = 1e-4;
+pub use restir_pt_interface::shader_interface::SEGMENT_EPSILON;
 
 /// Whether anything blocks the segment between surface points p (normal np, on triangle index
 /// tp) and q (normal nq, on triangle index tq): the ray of `segment_ray`, traced (the kernels

@@ -23,8 +23,7 @@ use glam::Vec3;
 
 use restir_pt_interface::gpu_types::Triangle;
 
-/// 2⁻¹⁷: the offset per unit of |v0| + |e1| + |e2| (see the module documentation).
-pub const RAY_OFFSET_SCALE: f32 = 1.0 / 131072.0;
+pub use restir_pt_interface::shader_interface::RAY_OFFSET_SCALE;
 
 /// The float next to `x` in direction `s` (s > 0: up, s < 0: down); `x` itself when s == 0,
 /// x == 0 (the next float is denormal, which GPUs may flush) or x is infinite.

@@ -2,19 +2,7 @@
 
 use glam::{UVec4, Vec4};
 
-/// Stream of [`rng_uniform4`]: the camera ray's jitter within the pixel (vertex 0).
-pub const STREAM_CAMERA: u32 = 0;
-/// Stream of [`rng_uniform4`]: BSDF sampling at a vertex (xy: direction, z: lobe choice, w:
-/// reflect/refract choice).
-pub const STREAM_BSDF: u32 = 1;
-/// Stream of [`rng_uniform4`]: next-event estimation at a vertex (the light choice and the point
-/// or direction on it).
-pub const STREAM_LIGHT: u32 = 2;
-/// ReSTIR's choices among candidates, keyed by a pass seed.
-pub const STREAM_RESAMPLE: u32 = 3;
-/// ReSTIR's choice of directional light k's NEE candidate at a vertex: stream
-/// `STREAM_DIRECTIONAL + k` (x).
-pub const STREAM_DIRECTIONAL: u32 = 4;
+pub use restir_pt_interface::shader_interface::{STREAM_BSDF, STREAM_CAMERA, STREAM_DIRECTIONAL, STREAM_LIGHT, STREAM_RESAMPLE};
 
 /// The 4D permuted congruential hash of Jarzynski and Olano (JCGT 2020).
 pub fn pcg4d(v: UVec4) -> UVec4 {

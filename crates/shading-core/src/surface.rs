@@ -7,35 +7,13 @@
 //! small. A scene with flat faces and no textures has none, and its kernels are compiled without
 //! them (`SCENE_SURFACE 0`).
 
-use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
 use restir_pt_interface::gpu_types::Triangle;
+use restir_pt_interface::shader_interface::SURFACE_MIN_LENGTH_SQUARED;
+pub use restir_pt_interface::surface_types::TriangleSurface;
 
 use crate::sampling::build_onb;
-
-/// The attributes of one triangle's three vertices (v0, v0 + e1, v0 + e2), in scene space
-/// (the triangles' coordinates), std430 layout of `TriangleSurface` in glsl/surface.glsl.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
-pub struct TriangleSurface {
-    /// xyz: the vertex normal (unit, or zero where the file gave none or the triangle is flat:
-    /// the face normal is used);
-    /// w: the vertex's COLOR_0 packed by [`pack_vertex_color`] (its bits; 0.0: no colour).
-    pub normal: [[f32; 4]; 3],
-    /// xyz: the vertex tangent (along +u of the normal texture's coordinates); w: its handedness
-    /// ±1, the bitangent being w · cross(normal, tangent) (glTF 2.0, section 3.7.2.1).
-    pub tangent: [[f32; 4]; 3],
-    /// xy: TEXCOORD_0, zw: TEXCOORD_1 of each vertex (0 where absent).
-    pub uv: [[f32; 4]; 3],
-}
-
-impl TriangleSurface {
-    /// A flat triangle: no vertex normals (the face normal is used), no tangents, uv 0.
-    pub fn flat() -> Self {
-        Self::default()
-    }
-}
 
 /// [`pack_vertex_color`]'s flag bit: the vertex has a colour.
 const VERTEX_COLOR_PRESENT: u32 = 1 << 31;
@@ -86,9 +64,6 @@ pub fn triangle_bary(tri: &Triangle, p: Vec3) -> Vec2 {
     Vec2::new(d11 * d20 - d01 * d21, d00 * d21 - d01 * d20) * inv
 }
 
-/// Interpolated vectors shorter than this (squared) count as missing.
-const MIN_LENGTH_SQUARED: f32 = 1e-12;
-
 /// The surface of triangle `tri` with attributes `attr` at barycentrics `bary` = (b1, b2) of
 /// vertices v0 + e1 and v0 + e2 (as `bvh::Hit::bary`): attributes interpolated linearly
 /// (b0 = 1 - b1 - b2), normal and tangent re-normalised and made orthogonal.
@@ -96,14 +71,14 @@ pub fn surface_at(tri: &Triangle, attr: &TriangleSurface, bary: Vec2) -> Surface
     let w = Vec3::new(1.0 - bary.x - bary.y, bary.x, bary.y);
     let lerp4 = |rows: &[[f32; 4]; 3]| Vec4::from(rows[0]) * w.x + Vec4::from(rows[1]) * w.y + Vec4::from(rows[2]) * w.z;
     let n = lerp4(&attr.normal).truncate();
-    let normal = if n.length_squared() > MIN_LENGTH_SQUARED {
+    let normal = if n.length_squared() > SURFACE_MIN_LENGTH_SQUARED {
         n.normalize()
     } else {
         tri.normal_area2().normalize()
     };
     let t4 = lerp4(&attr.tangent);
     let t = t4.truncate() - normal * normal.dot(t4.truncate());
-    let tangent = if t.length_squared() > MIN_LENGTH_SQUARED {
+    let tangent = if t.length_squared() > SURFACE_MIN_LENGTH_SQUARED {
         t.normalize()
     } else {
         build_onb(normal).0

@@ -34,8 +34,8 @@ pub use kernel::{
 };
 pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};
 pub use shader::{
-    compile_kernel, compile_kernel_cached_in, compile_kernels_in_parallel, glsl_source, process_cpu_ms, set_compile_threads, thread_cpu_ms,
-    CompiledKernel,
+    compile_glsl_source, compile_kernel, compile_kernel_cached_in, compile_kernels_in_parallel, glsl_source, process_cpu_ms,
+    set_compile_threads, thread_cpu_ms, CompiledKernel, GLSL_SOURCES,
 };
 pub use spirv_cache::{cache_dir as spirv_cache_dir, SPIRV_CACHE_ENV};
 pub use timer::PassTimer;

@@ -8,19 +8,15 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 
-use restir_pt_interface::shader_interface::{glsl_header, GLSL_HEADER_NAME};
-
 use super::spirv_cache;
 
-/// Every file under glsl/, keyed by its path relative to glsl/.
+/// Every file under glsl/ (but glsl/generated/), keyed by its path relative to glsl/, and the
+/// header that crates/vk/build.rs generated from crates/interface/ under its include name
+/// (`shader_interface.glsl`).
 pub static GLSL_SOURCES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/glsl_sources.rs"));
 
-/// The text of glsl/`name`, or of the header generated from crates/interface/src/shader_interface.rs when
-/// `name` is its include name.
+/// The text of glsl/`name`, or of the generated header when `name` is its include name.
 pub fn glsl_source(name: &str) -> Option<&'static str> {
-    if name == GLSL_HEADER_NAME {
-        return Some(glsl_header());
-    }
     GLSL_SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
@@ -210,6 +206,14 @@ pub fn compile_kernel_cached_in(name: &str, defines: &[(&str, &str)], dir: &Path
 /// without `-g`, which would only add line records.
 fn compile_glsl(name: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
     let source = glsl_source(name).ok_or_else(|| anyhow!("no GLSL kernel named {name} under glsl/"))?;
+    compile_glsl_source(name, source, defines)
+}
+
+/// Compiles the compute kernel text `source`, named `name` in messages and as the includer of
+/// its `#include`s (which resolve against the embedded glsl/ tree and the generated header as a
+/// file's under glsl/ do), with the options of every kernel; not cached. For kernels written by
+/// a program, such as the layout test's, which declares every generated record.
+pub fn compile_glsl_source(name: &str, source: &str, defines: &[(&str, &str)]) -> Result<Vec<u32>> {
     let compiler = shaderc::Compiler::new().map_err(|e| anyhow!("cannot initialise shaderc: {e}"))?;
     let mut options = shaderc::CompileOptions::new().map_err(|e| anyhow!("cannot create shaderc options: {e}"))?;
     options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);

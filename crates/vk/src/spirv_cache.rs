@@ -14,8 +14,6 @@ use std::sync::OnceLock;
 
 use sha2::{Digest, Sha256};
 
-use restir_pt_interface::shader_interface::glsl_header;
-
 use super::shader::GLSL_SOURCES;
 
 /// The environment variable that names the cache folder; the value `off` turns the cache off.
@@ -37,8 +35,8 @@ pub fn cache_dir() -> Option<PathBuf> {
     Some(base.join("restir-pt").join("spirv"))
 }
 
-/// The digest of every input shared by all kernels: the embedded GLSL tree, the generated
-/// header and the compile options' source, computed once per process.
+/// The digest of every input shared by all kernels: the embedded GLSL tree with the generated
+/// header, and the compile options' source, computed once per process.
 fn sources_digest() -> &'static [u8; 32] {
     static DIGEST: OnceLock<[u8; 32]> = OnceLock::new();
     DIGEST.get_or_init(|| {
@@ -47,7 +45,6 @@ fn sources_digest() -> &'static [u8; 32] {
             hash_field(&mut h, name.as_bytes());
             hash_field(&mut h, text.as_bytes());
         }
-        hash_field(&mut h, glsl_header().as_bytes());
         hash_field(&mut h, include_str!("shader.rs").as_bytes());
         h.finalize().into()
     })

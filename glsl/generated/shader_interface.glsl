@@ -1,0 +1,261 @@
+// Generated from crates/interface/ (shader_interface.rs `glsl_header`) when restir-pt-vk is built;
+// edit the Rust declarations, not this text.
+#ifndef SHADER_INTERFACE_GLSL
+#define SHADER_INTERFACE_GLSL
+
+#define SCENE_BINDING_FRAME_PARAMS 0
+#define SCENE_BINDING_TRIANGLES 1
+#define SCENE_BINDING_NODES 2
+#define SCENE_BINDING_MATERIALS 3
+#define SCENE_BINDING_EMITTERS 4
+#define PATHTRACE_BINDING_ACCUM 5
+#define PATHTRACE_BINDING_ACCUM_SQ 6
+#define PATHTRACE_BINDING_STATUS 7
+#define RESTIR_BINDING_REUSE_PARAMS 5
+#define RESTIR_BINDING_SURFACES0 6
+#define RESTIR_BINDING_SURFACES1 7
+#define RESTIR_BINDING_RESERVOIR_HEADS0 8
+#define RESTIR_BINDING_RESERVOIR_TAILS0 9
+#define RESTIR_BINDING_RESERVOIR_HEADS1 10
+#define RESTIR_BINDING_RESERVOIR_TAILS1 11
+#define RESTIR_BINDING_RESERVOIR_HEADS2 12
+#define RESTIR_BINDING_RESERVOIR_TAILS2 13
+#define RESTIR_BINDING_DIRECT 14
+#define RESTIR_BINDING_ACCUM 15
+#define RESTIR_BINDING_ACCUM_SQ 16
+#define RESTIR_BINDING_RESTIR_STATS 17
+#define RESTIR_BINDING_EXPECTATION 18
+#define SURFACE_BINDING_SURFACE_ATTRIBUTES 0
+#define SURFACE_BINDING_MATERIAL_TEXTURE_TABLE 1
+#define SURFACE_BINDING_TEXTURE_HEADERS 2
+#define SURFACE_BINDING_TEXELS 3
+#define SURFACE_DESCRIPTOR_SET 1
+
+#define SHIFT_RECONNECTION 0
+#define SHIFT_REPLAY 1
+#define SHIFT_HYBRID 2
+#define MIS_GBH 0
+#define MIS_PAIRWISE 1
+
+#define RESERVOIR_SLOTS 3u
+#define SURFACE_SLOTS 2u
+#define RESTIR_MAX_PASSES 6u
+#define MAX_INPUTS 9u
+#define IMAGE_LOCAL_SIZE 8u
+#define COUNTER_COUNT 7u
+#define RR_START_DEPTH 3u
+#define MAX_PATH_LENGTH 7u
+#define PUNCTUAL_ROWS 4u
+#define LIGHT_NODE_ROWS 4u
+#define LIGHT_TREE_MAX_DEPTH 32u
+#define RR_MAX_SURVIVAL 0.95
+
+const uint STREAM_CAMERA = 0u;
+const uint STREAM_BSDF = 1u;
+const uint STREAM_LIGHT = 2u;
+const uint STREAM_RESAMPLE = 3u;
+const uint STREAM_DIRECTIONAL = 4u;
+const uint COUNTER_TRAVERSALS = 0u;
+const uint COUNTER_NODE_VISITS = 1u;
+const uint COUNTER_TRIANGLE_TESTS = 2u;
+const uint COUNTER_PATH_STEPS = 3u;
+const uint COUNTER_NODE_ITERATIONS = 4u;
+const uint COUNTER_TRIANGLE_ITERATIONS = 5u;
+const uint COUNTER_STEP_ITERATIONS = 6u;
+const float SURFACE_MIN_LENGTH_SQUARED = 1e-12;
+const float DELTA_ALPHA = 0.001;
+const float INDEX_MATCHED_TOLERANCE = 1.5258789e-5;
+const float SEGMENT_EPSILON = 0.0001;
+const float RAY_OFFSET_SCALE = 7.6293945e-6;
+const uint MATERIAL_DOUBLE_SIDED = 1u;
+const uint MATERIAL_UNLIT = 2u;
+const uint MATERIAL_ALPHA_EMISSION = 4u;
+const uint MATERIAL_BLEND_EMISSION = 8u;
+const uint NO_EMITTER = 0xffffffffu;
+const uint NO_HIT = 0xffffffffu;
+const uint LEAF_COUNT_BITS = 4u;
+const uint LEAF_COUNT_MASK = 15u;
+const uint PUNCTUAL_LIGHT_BIT = 0x80000000u;
+const uint PUNCTUAL_POINT = 0u;
+const uint PUNCTUAL_SPOT = 1u;
+const uint PUNCTUAL_DIRECTIONAL = 2u;
+const uint LIGHT_NODE_LEAF = 1u;
+const uint LIGHT_NODE_TWO_SIDED = 2u;
+const uint FLAG_RUSSIAN_ROULETTE = 1u;
+const uint LOBE_NONE = 0u;
+const uint LOBE_DIFFUSE = 1u;
+const uint LOBE_CONDUCTOR = 2u;
+const uint LOBE_DIELECTRIC = 4u;
+const uint LOBE_DELTA = 8u;
+const uint LOBE_TRANSMISSION = 16u;
+const uint LOBE_BITS = 5u;
+const uint INFO_LENGTH_MASK = 15u;
+const uint INFO_RC_SHIFT = 4u;
+const uint INFO_NEE_END = 256u;
+const uint INFO_DIRECTIONAL_SHIFT = 9u;
+const uint NO_TEXTURE = 0xffffffffu;
+const uint TEXTURE_WRAP_REPEAT = 0u;
+const uint TEXTURE_WRAP_CLAMP = 1u;
+const uint TEXTURE_WRAP_MIRROR = 2u;
+const uint TEXTURE_NEAREST = 16u;
+const uint ALPHA_OPAQUE = 0u;
+const uint ALPHA_MASK = 1u;
+const uint ALPHA_BLEND = 2u;
+
+#define FRAME_PARAMS_FIELDS vec4 cam_position; vec4 cam_right; vec4 cam_up; vec4 cam_forward; vec4 scene_env; uint width; uint height; uint sample_offset; uint samples_per_dispatch; uint max_depth; uint render_seed; uint flags; uint emitter_count;
+
+struct Material {
+    vec3 base_color;                 // glTF baseColorFactor, linear RGB in [0, 1]: the diffuse albedo of non-metals and F0 of metals.
+    float metallic;                  // glTF metallicFactor in [0, 1]: the blend between the non-metal and the conductor lobes.
+    vec3 emission;                   // Emitted radiance, linear RGB in W/(m² sr): emissiveFactor already multiplied by `KHR_materials_emissive_strength`.
+    float roughness;                 // Perceptual (linear) roughness in [0, 1]; the GGX alpha is its square (`restir_pt_shading::bsdf::ggx_alpha`).
+    float transmission;              // `KHR_materials_transmission` transmissionFactor in [0, 1]: the dielectric interface lobe replaces that share of the non-metal part only (weights `bsdf::lobe_weights`).
+    float ior;                       // Index of refraction of the inside (`KHR_materials_ior`, glTF default 1.5); also sets the specular layer's F0 = ((ior - 1) / (ior + 1))² · specular_color.
+    uint flags;                      // Bit set: `MATERIAL_DOUBLE_SIDED`, `MATERIAL_UNLIT`, `MATERIAL_ALPHA_EMISSION`, `MATERIAL_BLEND_EMISSION`.
+    float specular;                  // `KHR_materials_specular` specularFactor: the strength of the non-metal specular layer (docs/materials.md); 0 makes the non-metal part purely Lambertian.
+    vec3 specular_color;             // `KHR_materials_specular` specularColorFactor (linear RGB), scaling the layer's F0.
+    uint pad;                        // Padding to a 16-byte multiple (std430); always 0.
+};
+
+struct Triangle {
+    vec3 v0;                         // Vertex 0, scene coordinates.
+    uint material;                   // Index into the scene's materials.
+    vec3 e1;                         // Vertex 1 minus vertex 0, scene coordinates.
+    uint emitter;                    // Index into the emitter table, or `NO_EMITTER` if the triangle does not emit.
+    vec3 e2;                         // Vertex 2 minus vertex 0, scene coordinates.
+    uint alpha_tested;               // 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0, set by `restir_pt_scene::Scene::build`: the traversal loops tell alpha-tested hits apart by it without loading materials (glsl/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
+};
+
+struct BvhNode {
+    vec3 lo;                         // Minimum corner of the node's bounding box, scene coordinates.
+    uint skip;                       // Index of the node to visit after this subtree (or after a missed box).
+    vec3 hi;                         // Maximum corner of the node's bounding box, scene coordinates.
+    uint leaf;                       // For a leaf, `(first triangle << LEAF_COUNT_BITS) | count` (see `BvhNode::leaf_range`); 0 for an interior node.
+};
+
+struct Emitter {
+    uint triangle;                   // The emissive triangle's index, or `PUNCTUAL_LIGHT_BIT` | the punctual light's index.
+    uint trail;                      // The light tree's bit trail (pbrt-v4 `BVHLightSampler`): bit d set when the path from the root to this light's leaf takes the second child at depth d; 0 for a directional light.
+    float intensity;                 // The light's largest radiant intensity, luminance (W/sr in the glTF emission unit): L·A for an emissive triangle, I for a point or spot light, the irradiance E for a directional light.
+    uint leaf;                       // Index of the light's leaf among the light tree's nodes; `NO_EMITTER` for directional lights, which NEE takes beside the tree's drawn light.
+};
+
+struct LightNode {
+    vec3 lo;                         // Lower corner of the bounds.
+    float intensity;                 // Sum of the lights' largest radiant intensities (luminance, W/sr).
+    vec3 hi;                         // Upper corner of the bounds.
+    float cos_theta_o;               // cos θ_o, θ_o the half-angle of the cone of normals (1: one direction, -1: all).
+    vec3 axis;                       // Unit axis of the cone of normals.
+    float cos_theta_e;               // cos θ_e, θ_e the angle beyond θ_o within which the lights still emit (0: a cosine lobe).
+    uint child;                      // A leaf's emitter row, an interior node's second child.
+    uint flags;                      // `LIGHT_NODE_LEAF` | `LIGHT_NODE_TWO_SIDED`.
+    uvec2 pad;                       // Zero; pads the node to whole rows.
+};
+
+struct RestirPass {
+    uint in_slot;                    // Reservoir slot (0-2) the pass reads.
+    uint out_slot;                   // Reservoir slot (0-2) the pass writes.
+    uint prev_slot;                  // Reservoir slot (0-2) holding the previous frame's result, for temporal reuse.
+    uint surface_slot;               // Surface slot (0-1) of the current frame; the previous frame's surfaces are the other one.
+    uint pass_seed;                  // Distinguishes the random choices of passes and reuse rounds within a frame.
+};
+
+#define REUSE_PARAMS_FIELDS vec4 prev_cam_position; vec4 prev_cam_right; vec4 prev_cam_up; vec4 prev_cam_forward; float roughness_threshold; float distance_threshold; float m_cap; float radius; float normal_threshold; float depth_threshold; uint frame_index; uint candidates; uint neighbours; uint temporal_valid; uint emission_rays; uint reservoirs; uint emission_history; RestirPass passes[6];
+
+struct Surface {
+    vec3 pos;                        // Hit point of the ray through the pixel centre, scene coordinates.
+    uint triangle;                   // The hit triangle, or `restir_pt_shading::bvh::NO_HIT` if the camera ray escaped.
+    vec3 camera;                     // The camera position the ray left from, scene coordinates.
+    float depth;                     // Distance from the camera to `pos`, scene units.
+};
+
+struct ReservoirHead {
+    uint seed;                       // `restir_pt_shading::path_record::PathRecord::seed`.
+    uint info;                       // `restir_pt_shading::path_record::PathRecord::info`.
+    uint lobes;                      // `restir_pt_shading::path_record::PathRecord::lobes`.
+    uint rc_triangle;                // `restir_pt_shading::path_record::PathRecord::rc_triangle`.
+    vec3 rc_pos;                     // `restir_pt_shading::path_record::PathRecord::rc_pos`.
+    float rc_pdf;                    // `restir_pt_shading::path_record::PathRecord::rc_pdf`.
+    vec3 rc_next;                    // `restir_pt_shading::path_record::PathRecord::rc_next`.
+    float rc_geometry;               // `restir_pt_shading::path_record::PathRecord::rc_geometry`.
+};
+
+struct ReservoirTail {
+    vec3 suffix;                     // `restir_pt_shading::path_record::PathRecord::suffix`.
+    float rc_pdf_after;              // `restir_pt_shading::path_record::PathRecord::rc_pdf_after`.
+    vec3 contribution;               // `restir_pt_shading::path_record::PathRecord::contribution`.
+    uint rc_next_triangle;           // `restir_pt_shading::path_record::PathRecord::rc_next_triangle`.
+    float weight;                    // The unbiased contribution weight W.
+    float confidence;                // The confidence weight M.
+    uint pad0;                       // Padding to 48 bytes; always 0.
+    uint pad1;                       // Padding to 48 bytes; always 0.
+};
+
+#define RESTIR_STATS_FIELDS uint max_loop_iterations; uint loop_budget_cut_groups; uint shifts_attempted; uint shifts_failed; uint nonfinite_weights; uint candidates_dropped; uint nonfinite_pixels; uint reuse_traversals; uint shift_subgroup_runs; uint subgroup_size;
+
+struct PathRecord {
+    uint seed;                       // The path's random-number key (`restir_pt_shading_core::rng::path_seed`): random replay regenerates the path from it.
+    uint info;                       // Bits 0-3: the length k; bits 4-7: the reconnection index r (0: none); bit 8: NEE end; bits 9-31: which NEE technique made the end (0: the light NEE draws; k + 1: directional light k, which NEE takes at every vertex).
+    uint lobes;                      // The lobe sampled at x1..x_{k-1}, 5 bits each (LOBE_NONE where NEE chose the next vertex).
+    uint rc_triangle;                // The triangle of x_r; NO_HIT if x_r is an escaped direction.
+    vec3 rc_pos;                     // x_r, or its direction if escaped.
+    float rc_pdf;                    // The solid-angle pdf that chose x_r from x_{r-1} (the BSDF's, or the light's for an NEE end).
+    vec3 rc_next;                    // x_{r+1}, or its direction if escaped; unused when x_r ends the path.
+    float rc_geometry;               // |cos_r| / |x_{r-1} - x_r|^2 at x_r (1 for an escaped x_r).
+    vec3 suffix;                     // prod_{i > r} f_s |cos| / p times the emission at the end: what x_r receives from the suffix (1 when x_r ends the path: its emission depends on the predecessor).
+    float rc_pdf_after;              // p(x_r -> x_{r+1} | x_{r-1}); 1 when x_r ends the path or NEE chose x_{r+1}.
+    vec3 contribution;               // f(X).
+    uint rc_next_triangle;           // The triangle of x_{r+1}; NO_HIT if escaped.
+};
+
+struct TriangleSurface {
+    vec4 normal[3];                  // xyz: the vertex normal (unit, or zero where the file gave none or the triangle is flat: the face normal is used); w: the vertex's COLOR_0 packed by `restir_pt_shading_core::surface::pack_vertex_color` (its bits; 0.0: no colour).
+    vec4 tangent[3];                 // xyz: the vertex tangent (along +u of the normal texture's coordinates); w: its handedness ±1, the bitangent being w · cross(normal, tangent) (glTF 2.0, section 3.7.2.1).
+    vec4 uv[3];                      // xy: TEXCOORD_0, zw: TEXCOORD_1 of each vertex (0 where absent).
+};
+
+struct TextureHeader {
+    uint width;                      // Width in texels.
+    uint height;                     // Height in texels.
+    uint offset;                     // Index of the first texel; rows run from the image's top row (v = 0) down.
+    uint sampler_bits;               // Wrap S in bits 0-1, wrap T in bits 2-3 (`TEXTURE_WRAP_*`), `TEXTURE_NEAREST`.
+};
+
+struct TextureSlot {
+    vec3 u_row;                      // First row of the affine uv map (identity: (1, 0, 0)).
+    uint texture_index;              // Index into the headers, or `NO_TEXTURE`.
+    vec3 v_row;                      // Second row of the affine uv map (identity: (0, 1, 0)).
+    uint texcoord;                   // TEXCOORD_0 or TEXCOORD_1.
+};
+
+struct MaterialTextures {
+    TextureSlot base_color;          // sRGB colour and linear alpha, multiplying the base colour factor.
+    TextureSlot metal_rough;         // Linear; B multiplies metallic, G roughness.
+    TextureSlot emissive;            // sRGB, multiplying the emission.
+    TextureSlot normal;              // Tangent-space normal, (x, y) scaled by `normal_scale`.
+    float normal_scale;              // glTF `normalTexture.scale`: multiplies the tangent-space normal's x and y (default 1).
+    float alpha_cutoff;              // glTF `alphaCutoff` (default 0.5): the alpha below which an `ALPHA_MASK` hit is discarded.
+    uint alpha_mode;                 // `ALPHA_OPAQUE`, `ALPHA_MASK` or `ALPHA_BLEND`.
+    float base_alpha;                // The alpha of the base colour factor.
+};
+
+struct ReuseToyInput {
+    float x;                         // The sample's position in its domain, in [0, 1].
+    float weight;                    // W_X: 1 / pdf(x); 0 for an empty reservoir.
+    float confidence;                // The confidence weight c.
+    uint domain;                     // The domain: 0 (canonical), 1 or 2.
+};
+
+struct ReuseOracleOutput {
+    vec3 expected;                   // The expectation of f(Y) W_Y over the choice, linear RGB.
+    float weight;                    // W of the result.
+    float confidence;                // M of the result.
+    float chosen_x;                  // The chosen sample's position in the canonical domain.
+    int chosen_input;                // The input the chosen sample came from; -1: none.
+    uint chosen_domain;              // The domain the chosen sample came from.
+    uint shifts_failed;              // Shifts that failed.
+    uint nonfinite_weights;          // Resampling weights that were not finite.
+    uvec2 pad;                       // Zero; pads the record to 48 bytes.
+};
+
+#endif
