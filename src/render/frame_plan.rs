@@ -2,64 +2,8 @@
 //! function of the frame's state, so that it is tested without a device.
 
 use super::reservoir_layers::RESERVOIR_SLOTS;
+pub use super::restir_passes::PassKernel;
 use crate::gpu_types::{RestirPass, RESTIR_MAX_PASSES};
-
-/// The kernels of a frame (glsl/restir_*.comp).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PassKernel {
-    /// Initial candidates: traces each pixel's candidate paths and resamples them into a
-    /// reservoir (glsl/restir_initial.comp).
-    Initial,
-    /// Temporal reuse with shifts, for a moved camera.
-    Temporal,
-    /// Temporal reuse of an unmoved camera, compiled without shift code.
-    TemporalUnmoved,
-    /// One round of spatial reuse from neighbouring pixels (glsl/restir_spatial.comp).
-    Spatial,
-    /// Shades the final reservoirs and accumulates the frame (glsl/restir_shade.comp).
-    Shade,
-}
-
-impl PassKernel {
-    /// Every kernel, in the order a frame runs them.
-    pub const ALL: [PassKernel; 5] = [
-        PassKernel::Initial,
-        PassKernel::Temporal,
-        PassKernel::TemporalUnmoved,
-        PassKernel::Spatial,
-        PassKernel::Shade,
-    ];
-
-    /// The GLSL file and extra `#define`s of the kernel.
-    pub fn source(self) -> (&'static str, &'static [(&'static str, &'static str)]) {
-        match self {
-            PassKernel::Initial => ("restir_initial.comp", &[]),
-            PassKernel::Temporal => ("restir_temporal.comp", &[]),
-            PassKernel::TemporalUnmoved => ("restir_temporal.comp", &[("CANONICAL_DOMAIN_ONLY", "1")]),
-            PassKernel::Spatial => ("restir_spatial.comp", &[]),
-            PassKernel::Shade => ("restir_shade.comp", &[]),
-        }
-    }
-
-    /// The timer slot of the pass (an index into `PASS_NAMES`).
-    pub fn timer_slot(self) -> usize {
-        match self {
-            PassKernel::Initial => 0,
-            PassKernel::Temporal | PassKernel::TemporalUnmoved => 1,
-            PassKernel::Spatial => 2,
-            PassKernel::Shade => 3,
-        }
-    }
-}
-
-/// How many passes a frame has (each timed on its own).
-pub const PASS_COUNT: usize = 4;
-
-/// The passes of a frame, the names its GPU times are reported under.
-pub const PASS_NAMES: [&str; PASS_COUNT] = ["initial", "temporal", "spatial", "shade"];
-
-/// GPU milliseconds of each pass of one frame, in the order of `PASS_NAMES`.
-pub type PassTimes = [f64; PASS_COUNT];
 
 /// What a frame starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

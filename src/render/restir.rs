@@ -9,18 +9,19 @@ use anyhow::{Context as _, Result};
 
 use self::buffers::RestirBuffers;
 use self::params::same_pose;
-use super::frame_plan::{plan_frame, FramePlan, FrameState, PassKernel, PassTimes, PASS_COUNT};
+use super::frame_plan::{plan_frame, FramePlan, FrameState};
 use super::image_readback::AccumReadback;
 use super::reservoir_layers::ReservoirLayers;
+use super::restir_passes::{PassDeclaration, PassKernel, PassTimes, PASS_COUNT};
 use super::{Image, RenderSettings, RestirSettings, SceneGpu};
 use crate::error::GpuError;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams};
 use crate::scene::Camera;
-use crate::shader_interface::{RestirBinding, IMAGE_LOCAL_SIZE};
+use crate::shader_interface::IMAGE_LOCAL_SIZE;
 use crate::shading::shift::ShiftParams;
 use crate::vk::{
-    compile_kernels_in_parallel, process_cpu_ms, twin_compile_pays, warm_up_on_twin, Binding, BindingFamilyExt, CompiledKernel, Context,
-    Kernel, KernelCompile, PassTimer, TwinKernel,
+    compile_kernels_in_parallel, process_cpu_ms, twin_compile_pays, warm_up_on_twin, Binding, BindingFamilyExt, BindingSlot,
+    CompiledKernel, Context, Kernel, KernelCompile, PassTimer, TwinKernel,
 };
 
 mod buffers;
@@ -57,6 +58,14 @@ fn halves_by_size(compiled: &[CompiledKernel]) -> (Vec<usize>, Vec<usize>) {
 /// LOCAL_SIZE² invocations (glsl/shift_path.glsl, `path_vertices`, `path_lobes`, `path_weights`),
 /// per vertex a 32-byte vertex, a lobe and a 16-byte weight row.
 const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
+
+/// The set-0 layout of `pass`'s kernel: the scene's bindings, then the ReSTIR buffers its row
+/// reads or writes.
+fn pass_layout(scene: &SceneGpu, pass: &PassDeclaration) -> Vec<BindingSlot> {
+    let mut layout = scene.bindings();
+    layout.extend(pass.bindings().into_iter().map(|b| b.slot(Binding::Storage)));
+    layout
+}
 
 /// What one ReSTIR PT frame ([`Restir::frame`]) took, and its counters.
 #[derive(Debug, Clone)]
@@ -221,8 +230,6 @@ impl Restir {
         self.buffers.params.write(std::slice::from_ref(&empty))?;
         self.buffers.reuse.write(std::slice::from_ref(&ReuseParams::default()))?;
         let scene_gpu = self.scene_gpu.clone();
-        let mut layout = scene_gpu.bindings();
-        layout.extend(RestirBinding::ALL.iter().map(|b| b.slot(Binding::Storage)));
         let mut defines = scene_gpu.defines();
         defines.extend(self.restir.defines());
         let jobs: Vec<(&str, Vec<(&str, &str)>)> = todo
@@ -235,12 +242,13 @@ impl Restir {
         let mut built = 0;
         let mut build_one = |this: &mut Self, i: usize, compiled: &CompiledKernel| -> Result<()> {
             built += 1;
-            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, compiled, layout.clone(), 4)?;
-            if todo[i] == PassKernel::TemporalUnmoved {
-                k.set_variant("(unmoved camera)");
+            let pass = todo[i].declaration();
+            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, compiled, pass_layout(&scene_gpu, pass), 4)?;
+            if let Some(variant) = pass.variant {
+                k.set_variant(variant);
             }
             progress(&format!("{} ({built}/{})", k.compile_report().name, todo.len()));
-            k.bind(&this.buffers.binding_table(&scene_gpu))?;
+            k.bind(&this.buffers.pass_table(&scene_gpu, pass))?;
             k.warm_up(&WARM_UP_PUSH).with_context(|| format!("compiling {}", k.name))?;
             this.kernels[todo[i] as usize] = Some(k);
             Ok(())
@@ -258,13 +266,17 @@ impl Restir {
             } else {
                 ((0..compiled.len()).collect(), Vec::new())
             };
-            let full_layout = scene_gpu.layout(layout.clone());
+            let layouts: Vec<_> = theirs
+                .iter()
+                .map(|&i| scene_gpu.layout(pass_layout(&scene_gpu, todo[i].declaration())))
+                .collect();
             let twin_kernels: Vec<TwinKernel> = theirs
                 .iter()
-                .map(|&i| TwinKernel {
+                .zip(&layouts)
+                .map(|(&i, layout)| TwinKernel {
                     name: jobs[i].0,
                     compiled: &compiled[i],
-                    layout: &full_layout,
+                    layout,
                     push: &WARM_UP_PUSH,
                 })
                 .collect();
@@ -319,9 +331,10 @@ impl Restir {
 
     /// Points every kernel's descriptors at the current buffers, by binding name.
     fn bind_buffers(&self) -> Result<()> {
-        let table = self.buffers.binding_table(&self.scene_gpu);
-        for kernel in self.built() {
-            kernel.bind(&table)?;
+        for (kernel, pass) in self.kernels.iter().zip(PassKernel::ALL) {
+            if let Some(k) = kernel {
+                k.bind(&self.buffers.pass_table(&self.scene_gpu, pass.declaration()))?;
+            }
         }
         Ok(())
     }

@@ -28,6 +28,7 @@ mod ray_offset;
 mod real_scenes;
 mod real_scenes_cli;
 mod restir;
+mod restir_passes;
 mod restir_unbiased;
 mod restir_unbiased_metal;
 mod reuse_oracle;

@@ -30,6 +30,87 @@ pub struct ReflectedBinding {
     pub block: String,
     /// Uniform or storage buffer (a `BufferBlock`-decorated uniform counts as storage).
     pub kind: Binding,
+    /// Some instruction of the module's functions loads from the buffer (or asks its array's
+    /// length, or passes a pointer into it to a function, which counts as both).
+    pub reads: bool,
+    /// Some instruction of the module's functions stores to the buffer (or runs an atomic on it).
+    pub writes: bool,
+}
+
+const OP_FUNCTION: u32 = 54;
+const OP_FUNCTION_CALL: u32 = 57;
+const OP_LOAD: u32 = 61;
+const OP_STORE: u32 = 62;
+const OP_COPY_MEMORY: u32 = 63;
+const OP_ACCESS_CHAIN: u32 = 65;
+const OP_IN_BOUNDS_ACCESS_CHAIN: u32 = 66;
+const OP_PTR_ACCESS_CHAIN: u32 = 67;
+const OP_ARRAY_LENGTH: u32 = 68;
+const OP_IN_BOUNDS_PTR_ACCESS_CHAIN: u32 = 70;
+const OP_COPY_OBJECT: u32 = 83;
+const OP_ATOMIC_LOAD: u32 = 227;
+const OP_ATOMIC_STORE: u32 = 228;
+const OP_ATOMIC_FIRST_READ_WRITE: u32 = 229; // OpAtomicExchange
+const OP_ATOMIC_LAST_READ_WRITE: u32 = 242; // OpAtomicXor
+const OP_ATOMIC_FADD_EXT: u32 = 6035;
+
+/// Which variables the module's functions read and write: pointers derived by access chains
+/// (and copies) are traced to their variable, then loads, stores, atomics, array lengths and
+/// pointer arguments of calls mark it. The map holds only variables that were accessed.
+fn variable_access(spirv: &[u32]) -> HashMap<u32, (bool, bool)> {
+    let mut root: HashMap<u32, u32> = HashMap::new();
+    let mut access: HashMap<u32, (bool, bool)> = HashMap::new();
+    let mut in_functions = false;
+    let mut i = 5;
+    while i < spirv.len() {
+        let (count, op) = ((spirv[i] >> 16) as usize, spirv[i] & 0xffff);
+        if count == 0 || i + count > spirv.len() {
+            break;
+        }
+        let args = &spirv[i + 1..i + count];
+        i += count;
+        match op {
+            OP_VARIABLE if args.len() >= 2 => {
+                root.insert(args[1], args[1]);
+            }
+            OP_FUNCTION => in_functions = true,
+            _ => {}
+        }
+        if !in_functions {
+            continue;
+        }
+        let var = |id: u32| root.get(&id).copied();
+        let mut mark = |id: u32, read: bool, write: bool| {
+            if let Some(v) = var(id) {
+                let e = access.entry(v).or_default();
+                e.0 |= read;
+                e.1 |= write;
+            }
+        };
+        match op {
+            OP_ACCESS_CHAIN | OP_IN_BOUNDS_ACCESS_CHAIN | OP_PTR_ACCESS_CHAIN | OP_IN_BOUNDS_PTR_ACCESS_CHAIN | OP_COPY_OBJECT
+                if args.len() >= 3 =>
+            {
+                if let Some(v) = var(args[2]) {
+                    root.insert(args[1], v);
+                }
+            }
+            OP_LOAD | OP_ARRAY_LENGTH | OP_ATOMIC_LOAD if args.len() >= 3 => mark(args[2], true, false),
+            OP_STORE | OP_ATOMIC_STORE if !args.is_empty() => mark(args[0], false, true),
+            OP_COPY_MEMORY if args.len() >= 2 => {
+                mark(args[0], false, true);
+                mark(args[1], true, false);
+            }
+            OP_ATOMIC_FIRST_READ_WRITE..=OP_ATOMIC_LAST_READ_WRITE | OP_ATOMIC_FADD_EXT if args.len() >= 3 => mark(args[2], true, true),
+            OP_FUNCTION_CALL if args.len() >= 3 => {
+                for &a in &args[3..] {
+                    mark(a, true, true);
+                }
+            }
+            _ => {}
+        }
+    }
+    access
 }
 
 fn spirv_string(words: &[u32]) -> String {
@@ -66,7 +147,7 @@ pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
         }
         i += count;
     }
-    let mut out: Vec<ReflectedBinding> = variables
+    let mut out: Vec<(ReflectedBinding, u32)> = variables
         .into_iter()
         .filter_map(|(pointer, id, class)| {
             let binding = *decorations.get(&(id, DECORATION_BINDING))?;
@@ -78,21 +159,31 @@ pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
                 STORAGE_CLASS_UNIFORM if decorations.contains_key(&(block, DECORATION_BLOCK)) => Binding::Uniform,
                 _ => return None,
             };
-            Some(ReflectedBinding {
+            let binding = ReflectedBinding {
                 set,
                 binding,
                 block: names.get(&block).cloned().unwrap_or_default(),
                 kind,
-            })
+                reads: false,
+                writes: false,
+            };
+            Some((binding, id))
         })
         .collect();
+    let access = variable_access(spirv);
+    for (b, id) in out.iter_mut() {
+        (b.reads, b.writes) = access.get(id).copied().unwrap_or_default();
+    }
+    let mut out: Vec<ReflectedBinding> = out.into_iter().map(|(b, _)| b).collect();
     out.sort_by_key(|b| (b.set, b.binding));
     out
 }
 
-/// Checks that every binding `spirv` declares is in `layout` under the same set and number, block name
-/// and descriptor kind. A binding of `layout` the module lacks is allowed (the compiler drops
-/// blocks a kernel never reads). The error names the kernel, the binding and both sides.
+/// Checks that every binding `spirv` accesses is in `layout` under the same set and number,
+/// block name and descriptor kind. A binding of `layout` the module lacks is allowed, and so is
+/// one the module declares but never reads or writes: it is not statically used (Vulkan 1.3,
+/// "Static Use"), so a pipeline layout may leave it out. The error names the kernel, the
+/// binding and both sides.
 pub fn check_bindings(kernel: &str, spirv: &[u32], layout: &[super::BindingSlot]) -> Result<(), String> {
     for (i, slot) in layout.iter().enumerate() {
         if layout[..i]
@@ -105,7 +196,7 @@ pub fn check_bindings(kernel: &str, spirv: &[u32], layout: &[super::BindingSlot]
             ));
         }
     }
-    for found in reflect_bindings(spirv) {
+    for found in reflect_bindings(spirv).into_iter().filter(|b| b.reads || b.writes) {
         let Some(slot) = layout.iter().find(|s| s.set == found.set && s.binding == found.binding) else {
             return Err(format!(
                 "kernel {kernel}: the shader declares binding {} ({}) of set {}, the host layout does not",

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use anyhow::Result;
 
 use super::super::reservoir_layers::ReservoirLayers;
+use super::super::restir_passes::PassDeclaration;
 use super::super::SceneGpu;
 use crate::gpu_types::{FrameParams, RestirStats, ReuseParams, Surface};
 use crate::shader_interface::{RestirBinding, SURFACE_SLOTS};
@@ -48,8 +49,18 @@ impl RestirBuffers {
         Ok(buffers)
     }
 
+    /// The bindings of `pass`'s kernel: the scene's, then those of these buffers its row reads
+    /// or writes.
+    pub fn pass_table<'a>(&'a self, scene: &'a SceneGpu, pass: &PassDeclaration) -> Vec<BoundBuffer<'a>> {
+        let ours = pass.bindings();
+        let restir = |b: &BoundBuffer| RestirBinding::ALL.iter().any(|r| r.block() == b.slot.block);
+        let mut table = self.binding_table(scene);
+        table.retain(|b| !restir(b) || ours.iter().any(|r| r.block() == b.slot.block));
+        table
+    }
+
     /// Every binding of the ReSTIR kernels, by name: the scene's, then these buffers.
-    pub fn binding_table<'a>(&'a self, scene: &'a SceneGpu) -> Vec<BoundBuffer<'a>> {
+    fn binding_table<'a>(&'a self, scene: &'a SceneGpu) -> Vec<BoundBuffer<'a>> {
         use RestirBinding as B;
         let layers = &self.layers;
         let mut table = scene.buffers(&self.params);

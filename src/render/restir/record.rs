@@ -3,7 +3,8 @@
 
 use ash::vk::CommandBuffer;
 
-use super::super::frame_plan::{FramePlan, PassKernel, PlannedPass, PASS_NAMES};
+use super::super::frame_plan::{FramePlan, PlannedPass};
+use super::super::restir_passes::{Dispatch, PASS_NAMES};
 use super::{Restir, LOCAL_SIZE};
 use crate::vk::record_compute_barrier;
 
@@ -33,13 +34,12 @@ impl Restir {
 
     /// One pass: its kernel over the image with its pass-table entry `index` as push constant,
     /// which names the reservoir slots it reads (`in_slot`, `prev_slot`) and writes
-    /// (`out_slot`) and the surfaces of the frame (`surface_slot`). Every pass but shading runs
-    /// once per reservoir (z); shading reads all of a pixel's reservoirs and writes the image.
+    /// (`out_slot`) and the surfaces of the frame (`surface_slot`), over the image as its row's
+    /// `Dispatch` says.
     fn record_pass(&self, cmd: CommandBuffer, index: u32, pass: &PlannedPass) {
-        let reservoirs = if pass.kernel == PassKernel::Shade {
-            1
-        } else {
-            self.restir.reservoirs
+        let reservoirs = match pass.kernel.declaration().dispatch {
+            Dispatch::PerPixel => 1,
+            Dispatch::PerReservoir => self.restir.reservoirs,
         };
         let groups = [
             self.settings.width.div_ceil(LOCAL_SIZE),
