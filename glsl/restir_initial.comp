@@ -1,6 +1,6 @@
 #version 460
 // ReSTIR PT pass 1: the pixel's surface (its hit through the pixel's centre), the emission seen
-// directly and the initial reservoir from `candidates` traced paths (restir_candidates.glsl),
+// directly and the initial reservoir from `initial.candidates` traced paths (restir_candidates.glsl),
 // each through its own sub-pixel position.
 #extension GL_GOOGLE_include_directive : require
 
@@ -24,13 +24,13 @@ vec3 seen_emission(vec3 camera, Hit hit, vec3 dir) {
 // start at the primary hit, so more rays cut the noise of a light's edge without bias.
 vec3 pixel_emission(uvec2 p, uint seed, vec3 camera, vec3 first_dir, Hit first_hit) {
     vec3 sum = seen_emission(camera, first_hit, first_dir);
-    for (uint j = 1u; j < emission_rays; ++j) {
+    for (uint j = 1u; j < initial.emission_rays; ++j) {
         loop_tick();
         vec4 jitter = rng_uniform4(seed, j, STREAM_CAMERA);
         vec3 dir = camera_ray_dir(float(p.x) + jitter.x, float(p.y) + jitter.y);
         sum += seen_emission(camera, trace_closest(camera, dir, SHIFT_RAY_TMAX), dir);
     }
-    return sum / float(emission_rays);
+    return sum / float(initial.emission_rays);
 }
 
 void main() {
@@ -39,7 +39,7 @@ void main() {
     uint pixel = p.y * width + p.x;
     uint index = reservoir_index(pixel, gl_GlobalInvocationID.z);
     if (inside) {
-        uint first = frame_index * candidates;
+        uint first = frame_index * initial.candidates;
         vec3 camera = cam_position.xyz;
         // The surface that picks temporal and spatial inputs is seen through the pixel's centre,
         // not through a candidate's position: inputs chosen by a candidate's own hit would make
@@ -55,11 +55,11 @@ void main() {
         Resampler s = resampler_begin();
         ShiftParams params = ShiftParams(roughness_threshold, distance_threshold);
         uint max_length = min(max_depth, MAX_PATH_LENGTH);
-        float scale = 1.0 / float(candidates);
+        float scale = 1.0 / float(initial.candidates);
         vec3 emission = vec3(0.0);
         // Each path has its own sub-pixel position, drawn from its seed (see Domain in
         // restir_reuse.glsl).
-        for (uint c = 0u; c < candidates; ++c) {
+        for (uint c = 0u; c < initial.candidates; ++c) {
             loop_tick();
             uint seed = path_seed(index, first + c, render_seed);
             vec4 jitter = rng_uniform4(seed, 0u, STREAM_CAMERA);
@@ -70,14 +70,14 @@ void main() {
             Vertex y1 = hit_vertex(hit);
             stream_path_candidates(s, camera, y1, seed, max_length, params, scale, (flags & FLAG_RUSSIAN_ROULETTE) != 0u);
         }
-        s.confidence = float(candidates);
+        s.confidence = float(initial.candidates);
         // Under an unmoved camera every frame estimates the same emission, so the estimate is
         // the running mean over the frames since the camera last moved (unbiased however they
-        // are weighted), over at most m_cap frames, the temporal reservoir's cap.
+        // are weighted), over at most temporal.m_cap frames, the temporal reservoir's cap.
         float frames = 1.0;
-        if (emission_history != 0u) {
+        if (initial.emission_history != 0u) {
             vec4 history = direct[index];
-            frames = min(history.w + 1.0, max(m_cap, 1.0));
+            frames = min(history.w + 1.0, max(temporal.m_cap, 1.0));
             emission = history.rgb + (emission - history.rgb) / frames;
         }
         direct[index] = vec4(emission, frames);

@@ -48,7 +48,7 @@ Reservoir input_reservoir(uint i) {
 }
 
 CameraPose previous_camera() {
-    return CameraPose(prev_cam_position, prev_cam_right, prev_cam_up, prev_cam_forward);
+    return CameraPose(temporal.prev_cam_position, temporal.prev_cam_right, temporal.prev_cam_up, temporal.prev_cam_forward);
 }
 
 CameraPose domain_camera(Domain d) {

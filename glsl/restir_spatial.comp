@@ -25,10 +25,10 @@ void main() {
             inputs[0] = ReuseInput(in_slot, index, Domain(p, false));
             confidences[0] = canonical.M;
             uint n = 1u;
-            for (uint j = 0u; j < min(neighbours, MAX_INPUTS - 1u); ++j) {
+            for (uint j = 0u; j < min(spatial.neighbours, MAX_INPUTS - 1u); ++j) {
                 loop_tick();
                 vec4 u = rng_uniform4(seed, MAX_INPUTS + j, STREAM_RESAMPLE);
-                float r = radius * sqrt(u.x);
+                float r = spatial.radius * sqrt(u.x);
                 float phi = 2.0 * PI * u.y;
                 ivec2 q = ivec2(floor(vec2(p) + 0.5 + r * vec2(cos(phi), sin(phi))));
                 if (q.x < 0 || q.y < 0 || q.x >= int(width) || q.y >= int(height) || all(equal(uvec2(q), p))) continue;

@@ -14,11 +14,11 @@ layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
 // The previous frame's pixel that saw `pos`, if any.
 bool reproject(vec3 pos, out uint pixel) {
-    vec3 d = pos - prev_cam_position.xyz;
-    float z = dot(d, prev_cam_forward.xyz);
+    vec3 d = pos - temporal.prev_cam_position.xyz;
+    float z = dot(d, temporal.prev_cam_forward.xyz);
     if (!(z > 0.0)) return false;
-    float x = dot(d, prev_cam_right.xyz) / (z * prev_cam_position.w * prev_cam_right.w);
-    float y = dot(d, prev_cam_up.xyz) / (z * prev_cam_position.w);
+    float x = dot(d, temporal.prev_cam_right.xyz) / (z * temporal.prev_cam_position.w * temporal.prev_cam_right.w);
+    float y = dot(d, temporal.prev_cam_up.xyz) / (z * temporal.prev_cam_position.w);
     vec2 image = vec2((x + 1.0) * 0.5 * float(width), (1.0 - y) * 0.5 * float(height));
     if (!(image.x >= 0.0 && image.y >= 0.0 && image.x < float(width) && image.y < float(height))) return false;
     pixel = uint(image.y) * width + uint(image.x);
@@ -49,11 +49,11 @@ void main() {
         if (!unmoved && surface.triangle != NO_HIT && reproject(surface.pos, prev_pixel)) {
             reusable = similar_surfaces(surface, load_surface(1u - surface_slot, prev_pixel));
         }
-        if (temporal_valid != 0u && reusable) {
+        if (temporal.valid != 0u && reusable) {
             inputs[0] = ReuseInput(in_slot, index, Domain(p, false));
             confidences[0] = canonical.M;
             uint prev_index = reservoir_index(prev_pixel, layer);
-            float confidence = min(load_reservoir(prev_slot, prev_index).M, m_cap * canonical.M);
+            float confidence = min(load_reservoir(prev_slot, prev_index).M, temporal.m_cap * canonical.M);
             inputs[1] = ReuseInput(prev_slot, prev_index, Domain(uvec2(prev_pixel % width, prev_pixel / width), true));
             confidences[1] = confidence;
             vec3 expected;

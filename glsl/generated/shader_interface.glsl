@@ -160,7 +160,28 @@ struct RestirPass {
     uint pass_seed;                  // Distinguishes the random choices of passes and reuse rounds within a frame.
 };
 
-#define REUSE_PARAMS_FIELDS vec4 prev_cam_position; vec4 prev_cam_right; vec4 prev_cam_up; vec4 prev_cam_forward; float roughness_threshold; float distance_threshold; float m_cap; float radius; float normal_threshold; float depth_threshold; uint frame_index; uint candidates; uint neighbours; uint temporal_valid; uint emission_rays; uint reservoirs; uint emission_history; RestirPass passes[6];
+struct TemporalParams {
+    vec4 prev_cam_position;          // The previous frame's camera position and tan(yfov / 2), laid out like `FrameParams::cam_position`.
+    vec4 prev_cam_right;             // The previous frame's right axis and aspect ratio, as `FrameParams::cam_right`.
+    vec4 prev_cam_up;                // The previous frame's up axis, as `FrameParams::cam_up`.
+    vec4 prev_cam_forward;           // The previous frame's viewing direction, as `FrameParams::cam_forward`.
+    float m_cap;                     // Confidence cap of the history, as a multiple of the current reservoir's M; the initial pass also caps the running mean of the emission seen directly at this many frames.
+    uint valid;                      // 1 if the previous frame's reservoirs and surfaces exist and temporal reuse is on.
+    uvec2 pad;                       // Zero; pads the record to its 16-byte alignment.
+};
+
+struct InitialParams {
+    uint candidates;                 // Candidate paths per pixel and reservoir.
+    uint emission_rays;              // Jittered camera rays per reservoir for the emission seen directly.
+    uint emission_history;           // 1 if the direct-emission buffer holds the running mean for this same camera pose.
+};
+
+struct SpatialParams {
+    uint neighbours;                 // Neighbours per round.
+    float radius;                    // Reuse radius in pixels.
+};
+
+#define REUSE_PARAMS_FIELDS TemporalParams temporal; float roughness_threshold; float distance_threshold; float normal_threshold; float depth_threshold; uint frame_index; uint reservoirs; InitialParams initial; SpatialParams spatial; RestirPass passes[6];
 
 struct Surface {
     vec3 pos;                        // Hit point of the ray through the pixel centre, scene coordinates.

@@ -296,13 +296,13 @@ gpu_record! {
 pub use crate::shader_interface::RESTIR_MAX_PASSES;
 
 gpu_record! {
-    block;
-    /// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: the frame's reuse
-    /// parameters and its pass table.
+    struct;
+    /// What the temporal pass reads of [`ReuseParams`]: the previous frame's camera, through which
+    /// it reprojects, and the history's confidence cap.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
-    pub struct ReuseParams {
+    pub struct TemporalParams {
         /// The previous frame's camera position and tan(yfov / 2), laid out like
-        /// [`FrameParams::cam_position`]; temporal reuse reprojects through it.
+        /// [`FrameParams::cam_position`].
         pub prev_cam_position: [f32; 4],
         /// The previous frame's right axis and aspect ratio, as [`FrameParams::cam_right`].
         pub prev_cam_right: [f32; 4],
@@ -310,35 +310,72 @@ gpu_record! {
         pub prev_cam_up: [f32; 4],
         /// The previous frame's viewing direction, as [`FrameParams::cam_forward`].
         pub prev_cam_forward: [f32; 4],
+        /// Confidence cap of the history, as a multiple of the current reservoir's M; the initial
+        /// pass also caps the running mean of the emission seen directly at this many frames.
+        pub m_cap: f32,
+        /// 1 if the previous frame's reservoirs and surfaces exist and temporal reuse is on.
+        pub valid: u32,
+        /// Zero; pads the record to its 16-byte alignment.
+        pub pad: [u32; 2],
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What the initial pass reads of [`ReuseParams`].
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct InitialParams {
+        /// Candidate paths per pixel and reservoir.
+        pub candidates: u32,
+        /// Jittered camera rays per reservoir for the emission seen directly.
+        pub emission_rays: u32,
+        /// 1 if the direct-emission buffer holds the running mean for this same camera pose.
+        pub emission_history: u32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What a spatial round reads of [`ReuseParams`].
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SpatialParams {
+        /// Neighbours per round.
+        pub neighbours: u32,
+        /// Reuse radius in pixels.
+        pub radius: f32,
+    }
+}
+
+gpu_record! {
+    block;
+    /// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: what every pass
+    /// shares, a group per pass that reads it alone (as RTXDI's per-pass parameter structs),
+    /// and the frame's pass table.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct ReuseParams {
+        /// The temporal pass's parameters.
+        pub temporal: TemporalParams,
         /// Perceptual roughness below which a glossy vertex cannot be a reconnection vertex
-        /// (`restir_pt_shading::shift::ShiftParams`).
+        /// (`restir_pt_shading::shift::ShiftParams`): where the initial pass records a path's
+        /// reconnection vertex and the reuse passes' shifts reconnect.
         pub roughness_threshold: f32,
         /// Minimum distance, in scene units, between a reconnection vertex and its predecessor.
         pub distance_threshold: f32,
-        /// Temporal confidence cap, as a multiple of the current reservoir's M.
-        pub m_cap: f32,
-        /// Spatial reuse radius in pixels.
-        pub radius: f32,
-        /// Neighbours' surfaces need |dot(n, n')| >= this (unit geometric normals).
+        /// Reused surfaces (temporal and spatial) need |dot(n, n')| >= this (unit geometric
+        /// normals).
         pub normal_threshold: f32,
-        /// Neighbours need |depth' - |x - camera'|| <= this * depth', x the canonical pixel's hit: a
-        /// relative depth tolerance.
+        /// Reused surfaces need |depth' - |x - camera'|| <= this * depth', x the canonical
+        /// pixel's hit: a relative depth tolerance.
         pub depth_threshold: f32,
         /// Frames rendered since the renderer was built or last reset; keys the frame's random
         /// numbers.
         pub frame_index: u32,
-        /// Initial candidate paths per pixel and reservoir.
-        pub candidates: u32,
-        /// Spatial neighbours per reuse round.
-        pub neighbours: u32,
-        /// 1 if the previous frame's reservoirs and surfaces exist and temporal reuse is on.
-        pub temporal_valid: u32,
-        /// Jittered camera rays per reservoir for the emission seen directly.
-        pub emission_rays: u32,
         /// Independent reservoirs per pixel.
         pub reservoirs: u32,
-        /// 1 if the direct-emission buffer holds the running mean for this same camera pose.
-        pub emission_history: u32,
+        /// The initial pass's parameters.
+        pub initial: InitialParams,
+        /// The spatial rounds' parameters.
+        pub spatial: SpatialParams,
         /// The frame's passes in dispatch order; a dispatch's push constant indexes them.
         pub passes: [RestirPass; RESTIR_MAX_PASSES],
     }

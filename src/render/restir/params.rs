@@ -2,32 +2,39 @@
 
 use super::super::frame_plan::{pass_table, FramePlan};
 use super::Restir;
-use crate::gpu_types::{FrameParams, ReuseParams};
+use crate::gpu_types::{FrameParams, InitialParams, ReuseParams, SpatialParams, TemporalParams};
 
 impl Restir {
     /// The reuse parameters of a frame seen from `frame` after `prev`, with its pass table.
     pub(super) fn reuse_params(&self, prev: &FrameParams, frame: &FrameParams, plan: &FramePlan, accumulate: bool) -> ReuseParams {
         let temporal_valid = self.restir.temporal && self.history.is_some();
         ReuseParams {
-            prev_cam_position: prev.cam_position,
-            prev_cam_right: prev.cam_right,
-            prev_cam_up: prev.cam_up,
-            prev_cam_forward: prev.cam_forward,
+            temporal: TemporalParams {
+                prev_cam_position: prev.cam_position,
+                prev_cam_right: prev.cam_right,
+                prev_cam_up: prev.cam_up,
+                prev_cam_forward: prev.cam_forward,
+                m_cap: self.restir.m_cap,
+                valid: temporal_valid as u32,
+                pad: [0; 2],
+            },
             roughness_threshold: self.shift_params.roughness_threshold,
             distance_threshold: self.shift_params.distance_threshold,
-            m_cap: self.restir.m_cap,
-            radius: self.restir.radius,
             normal_threshold: self.restir.normal_threshold,
             depth_threshold: self.restir.depth_threshold,
             frame_index: self.frame_index,
-            candidates: self.restir.candidates,
-            neighbours: self.restir.spatial,
-            temporal_valid: temporal_valid as u32,
-            emission_rays: self.restir.emission_rays,
             reservoirs: self.restir.reservoirs,
-            // Frames being accumulated are averaged already; a running mean inside them would
-            // only weigh the early frames' rays more.
-            emission_history: (temporal_valid && same_pose(prev, frame) && !accumulate) as u32,
+            initial: InitialParams {
+                candidates: self.restir.candidates,
+                emission_rays: self.restir.emission_rays,
+                // Frames being accumulated are averaged already; a running mean inside them
+                // would only weigh the early frames' rays more.
+                emission_history: (temporal_valid && same_pose(prev, frame) && !accumulate) as u32,
+            },
+            spatial: SpatialParams {
+                neighbours: self.restir.spatial,
+                radius: self.restir.radius,
+            },
             passes: pass_table(plan),
         }
     }
