@@ -8,14 +8,14 @@
 #ifndef PATH_TRACER_GLSL
 #define PATH_TRACER_GLSL
 
-#include "bsdf.glsl"
-#include "bvh.glsl"
-#include "camera.glsl"
-#include "lights.glsl"
-#include "punctual.glsl"
-#include "rng.glsl"
-#include "shading_frame.glsl"
-#include "trace_pair.glsl"
+#include "shading_core/bsdf.glsl"
+#include "shading_core/bvh.glsl"
+#include "scene/camera.glsl"
+#include "shading/lights.glsl"
+#include "shading/punctual.glsl"
+#include "shading_core/rng.glsl"
+#include "scene/hit_surface.glsl"
+#include "shading_core/trace_pair.glsl"
 
 const float RAY_TMAX = 1e30;
 

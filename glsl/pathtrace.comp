@@ -7,7 +7,7 @@
 
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
-#include "scene_bindings.glsl"
+#include "interface/scene_bindings.glsl"
 #include "path_tracer.glsl"
 
 layout(std430, set = 0, binding = PATHTRACE_BINDING_ACCUM) buffer Accum { vec4 accum[]; };       // rgb: sum of L, w: count

@@ -8,9 +8,9 @@
 
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
-#include "restir_bindings.glsl"
-#include "restir_candidates.glsl"
-#include "camera.glsl"
+#include "interface/restir_bindings.glsl"
+#include "shading/candidates.glsl"
+#include "scene/camera.glsl"
 
 // The radiance a camera ray from `camera` in `dir` receives directly from what it hits (or
 // escapes to): end_emission of the one-segment path.

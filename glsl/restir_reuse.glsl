@@ -8,10 +8,10 @@
 // Every traversal of a reuse kernel belongs to a shift; counting them gives rays per shift.
 #define COUNT_TRAVERSALS 1
 
-#include "restir_bindings.glsl"
-#include "camera.glsl"
-#include "gris.glsl"
-#include "shift.glsl"
+#include "interface/restir_bindings.glsl"
+#include "scene/camera.glsl"
+#include "shading_core/gris.glsl"
+#include "shading/shift.glsl"
 
 #ifndef SHIFT_MODE
 #define SHIFT_MODE SHIFT_HYBRID
@@ -122,7 +122,7 @@ ShiftResult shift_path(PathRecord record, Domain to) {
 }
 
 // The reuse loop, on the bridge above.
-#include "resample_inputs.glsl"
+#include "shading/resample_inputs.glsl"
 
 // Whether a neighbour's primary hit is similar enough to the canonical one to be reused: both
 // hit a surface, normals agree, and the neighbour's depth agrees with the canonical point's

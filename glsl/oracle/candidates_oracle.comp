@@ -6,13 +6,13 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../scene_bindings.glsl"
+#include "interface/scene_bindings.glsl"
 
 // The pass counters restir_candidates.glsl expects (restir_bindings.glsl in the kernels).
 uint local_nonfinite_weights = 0u;
 uint local_candidates_dropped = 0u;
 
-#include "../restir_candidates.glsl"
+#include "shading/candidates.glsl"
 
 // x: the longest path, y: roughness threshold, z: distance threshold, w: the candidates' MIS
 // scale (float bits).

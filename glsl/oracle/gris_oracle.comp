@@ -5,8 +5,8 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../gris.glsl"
-#include "../reservoir.glsl"
+#include "shading_core/gris.glsl"
+#include "shading_core/reservoir.glsl"
 
 // Per item: the number of inputs n, their confidences c_l, and for each input i the row
 // p̂_{<-l}(y_i), l = 0..n-1.

@@ -10,8 +10,8 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../reservoir.glsl"
-#include "../shift_result.glsl"
+#include "shading_core/reservoir.glsl"
+#include "shading/shift/result.glsl"
 
 struct Domain {
     uint index;
@@ -108,7 +108,7 @@ ShiftResult shift_path(PathRecord x, Domain to) {
     return s;
 }
 
-#include "../resample_inputs.glsl"
+#include "shading/resample_inputs.glsl"
 
 void main() {
     uint item = gl_GlobalInvocationID.x;

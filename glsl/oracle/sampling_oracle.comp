@@ -3,7 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../sampling.glsl"
+#include "shading_core/sampling.glsl"
 
 // Per item: u (xy used), params (xyz: direction or normal, w: alpha).
 layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };

@@ -8,7 +8,7 @@
 #ifndef SHADING_FRAME_GLSL
 #define SHADING_FRAME_GLSL
 
-#include "texture.glsl"
+#include "shading_core/texture.glsl"
 
 #ifndef SCENE_SHADING_NORMALS
 #define SCENE_SHADING_NORMALS 0

@@ -11,8 +11,8 @@
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
 
-#include "reservoir.glsl"
-#include "shift.glsl"
+#include "shading_core/reservoir.glsl"
+#include "shading/shift.glsl"
 
 // A candidate of the path being traced, described against that path: its first `count`
 // vertices, the last replaced by a NEE light vertex when `nee_end`. The path only grows, so

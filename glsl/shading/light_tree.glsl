@@ -7,8 +7,8 @@
 #ifndef LIGHT_TREE_GLSL
 #define LIGHT_TREE_GLSL
 
-#include "loop_budget.glsl"
-#include "types.glsl"
+#include "interface/loop_budget.glsl"
+#include "interface/types.glsl"
 
 struct LightNode {
     vec3 lo;

@@ -8,10 +8,10 @@
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
 
-#include "light_tree.glsl"
-#include "sampling.glsl"
-#include "texture.glsl"
-#include "types.glsl"
+#include "shading/light_tree.glsl"
+#include "shading_core/sampling.glsl"
+#include "shading_core/texture.glsl"
+#include "interface/types.glsl"
 
 // Specialisation like the BSDF lobes: a scene without an environment or without emissive
 // triangles compiles that half of NEE out. Both default to on.

@@ -2,8 +2,8 @@
 #ifndef PUNCTUAL_GLSL
 #define PUNCTUAL_GLSL
 
-#include "bvh.glsl"
-#include "lights.glsl"
+#include "shading_core/bvh.glsl"
+#include "shading/lights.glsl"
 
 // The shadow ray from surface point x (normal n, on triangle index tri) to a punctual light along
 // the unit `dir` at distance `dist` (+inf: a directional light). Only x is offset: the light is a

@@ -16,10 +16,10 @@
 #ifndef RESAMPLE_INPUTS_GLSL
 #define RESAMPLE_INPUTS_GLSL
 
-#include "gris.glsl"
-#include "reservoir.glsl"
-#include "rng.glsl"
-#include "shift_result.glsl"
+#include "shading_core/gris.glsl"
+#include "shading_core/reservoir.glsl"
+#include "shading_core/rng.glsl"
+#include "shading/shift/result.glsl"
 
 // Resamples inputs 0..n-1 (0: the canonical pixel's own reservoir), whose confidence weights
 // c_l the caller has put in `confidences` (gris.glsl), into one reservoir of the canonical

@@ -6,7 +6,7 @@
 #ifndef SHIFT_GLSL
 #define SHIFT_GLSL
 
-#include "shift_reconnection.glsl"
+#include "shading/shift/reconnection.glsl"
 
 // Random replay on a regenerated path `y` (trace_vertices of the base's length and end type):
 // valid if it carries light and samples the base's lobes.

@@ -11,7 +11,7 @@
 #ifndef ALPHA_PASS_GLSL
 #define ALPHA_PASS_GLSL
 
-#include "alpha.glsl"
+#include "shading_core/alpha.glsl"
 
 struct AlphaPass {
     Hit opaque;        // nearest hit on a triangle without alpha testing; t = tmax, NO_HIT if none

@@ -4,7 +4,7 @@
 #ifndef ALPHA_TRACE_GLSL
 #define ALPHA_TRACE_GLSL
 
-#include "alpha_pass.glsl"
+#include "shading_core/alpha_pass.glsl"
 
 // One pass of the ray (o, d) over the BVH: boxes are culled at the nearest opaque hit so far, so
 // that every alpha-tested hit before it is met; with any_hit the pass ends at an opaque hit.

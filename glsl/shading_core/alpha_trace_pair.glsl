@@ -5,7 +5,7 @@
 #ifndef ALPHA_TRACE_PAIR_GLSL
 #define ALPHA_TRACE_PAIR_GLSL
 
-#include "alpha_pass.glsl"
+#include "shading_core/alpha_pass.glsl"
 
 // Tests triangle index i for the closest ray (if enter_c) and the shadow ray (if enter_s).
 void alpha_pair_test(uint i, PairRay closest, PairRay shadow, bool enter_c, bool enter_s, inout AlphaPass c, inout AlphaPass s) {

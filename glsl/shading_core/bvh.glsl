@@ -3,10 +3,10 @@
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
-#include "counters.glsl"
-#include "loop_budget.glsl"
-#include "ray_offset.glsl"
-#include "types.glsl"
+#include "interface/counters.glsl"
+#include "interface/loop_budget.glsl"
+#include "shading_core/ray_offset.glsl"
+#include "interface/types.glsl"
 
 #ifndef SCENE_ALPHA
 #define SCENE_ALPHA 0
@@ -57,7 +57,7 @@ vec3 safe_inverse(vec3 d) {
 }
 
 #if SCENE_ALPHA
-#include "alpha_trace.glsl"
+#include "shading_core/alpha_trace.glsl"
 #else
 // Closest hit when any_hit is false; the first hit found otherwise (shadow rays). With
 // SCENE_ALPHA, hits that alpha_keeps rejects do not count (alpha_trace.glsl). Stackless: the

@@ -7,7 +7,7 @@
 #ifndef TRACE_PAIR_GLSL
 #define TRACE_PAIR_GLSL
 
-#include "bvh.glsl"
+#include "shading_core/bvh.glsl"
 
 // 1: small scenes bound as uniform buffers test every triangle in index order; no node is loaded
 // and every lane runs the same iterations. 0: the BVH, traversed once for both rays.
@@ -23,7 +23,7 @@ struct PairRay {
 };
 
 #if SCENE_ALPHA
-#include "alpha_trace_pair.glsl"
+#include "shading_core/alpha_trace_pair.glsl"
 #elif SCENE_BRUTE_FORCE
 void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded) {
     hit = Hit(closest.tmax, NO_HIT, vec2(0.0));

@@ -4,7 +4,7 @@
 #ifndef SHIFT_RESULT_GLSL
 #define SHIFT_RESULT_GLSL
 
-#include "path_record.glsl"
+#include "shading_core/path_record.glsl"
 
 struct ShiftResult {
     bool valid;
