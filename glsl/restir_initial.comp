@@ -1,6 +1,6 @@
 #version 460
 // ReSTIR PT pass 1: the pixel's surface (its hit through the pixel's centre), the emission seen
-// directly and the initial reservoir from `candidates` traced paths (restir_candidates.glsl),
+// directly and the initial reservoir from `candidates` traced paths (shading/candidates.glsl),
 // each through its own sub-pixel position.
 #extension GL_GOOGLE_include_directive : require
 

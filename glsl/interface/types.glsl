@@ -28,7 +28,7 @@ struct Triangle {
     vec3 e1;
     uint emitter;       // index into the emitter table, NO_EMITTER if not emissive
     vec3 e2;
-    uint alpha_tested;  // 1 if the material's alphaMode is MASK or BLEND (alpha.glsl), else 0
+    uint alpha_tested;  // 1 if the material's alphaMode is MASK or BLEND (shading_core/alpha.glsl), else 0
 };
 const uint NO_EMITTER = 0xffffffffu;
 
@@ -47,7 +47,7 @@ const uint LEAF_COUNT_MASK = 15u;
 
 // One light NEE can choose: emissive triangles, then point and spot lights (the light tree's
 // leaves), then directional lights. After the emitter_count entries, the buffer holds the light
-// tree (light_tree.glsl), then PUNCTUAL_ROWS rows per punctual light, each 16-byte row read as
+// tree (shading/light_tree.glsl), then PUNCTUAL_ROWS rows per punctual light, each 16-byte row read as
 // four words: (position, kind), (direction, cos outer), (intensity, cos inner), (emitter row, 0,
 // 0, 0); then the environment map. Twin: gpu_types::Emitter, gpu_types::punctual_rows.
 struct Emitter {

@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: alpha testing in traversal (glsl/alpha.glsl inside bvh_traverse and
+// Oracle kernel: alpha testing in traversal (glsl/shading_core/alpha.glsl inside bvh_traverse and
 // trace_pair) on a scene with MASK and BLEND materials (twins: crates/shading-core/src/alpha.rs,
 // crates/shading-core/src/bvh.rs, crates/shading-core/src/texture.rs). Compiled with the scene's defines, SCENE_ALPHA
 // among them. Everything is bound in set 0: the scene at 0-4, the surface bindings at 5-8, then

@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: the reuse loop (resample_inputs.glsl, MIS_MODE as compiled) on the analytic
+// Oracle kernel: the reuse loop (shading/resample_inputs.glsl, MIS_MODE as compiled) on the analytic
 // domains of the GRIS toy (tests/suite/gris.rs), one resampling per item. Twin: resample_inputs
 // in crates/shading/src/resample_inputs.rs on the same bridge (ToyDomains in tests/suite/reuse_oracle.rs).
 //

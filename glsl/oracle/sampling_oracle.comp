@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: the warps of sampling.glsl on given uniforms (twin: crates/shading-core/src/sampling.rs).
+// Oracle kernel: the warps of shading_core/sampling.glsl on given uniforms (twin: crates/shading-core/src/sampling.rs).
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 

@@ -1,4 +1,4 @@
-// Shadow rays towards punctual lights. Expects bvh.glsl and lights.glsl. Twin: crates/shading/src/lights.rs.
+// Shadow rays towards punctual lights. Expects shading_core/bvh.glsl and shading/lights.glsl. Twin: crates/shading/src/lights.rs.
 #ifndef PUNCTUAL_GLSL
 #define PUNCTUAL_GLSL
 

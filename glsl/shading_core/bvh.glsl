@@ -1,5 +1,5 @@
 // Ray-triangle intersection and stack traversal of the flattened BVH. Expects the scene buffers
-// `triangles` and `nodes` (scene_bindings.glsl). Twin: crates/shading-core/src/bvh.rs.
+// `triangles` and `nodes` (interface/scene_bindings.glsl). Twin: crates/shading-core/src/bvh.rs.
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
@@ -60,7 +60,7 @@ vec3 safe_inverse(vec3 d) {
 #include "shading_core/alpha_trace.glsl"
 #else
 // Closest hit when any_hit is false; the first hit found otherwise (shadow rays). With
-// SCENE_ALPHA, hits that alpha_keeps rejects do not count (alpha_trace.glsl). Stackless: the
+// SCENE_ALPHA, hits that alpha_keeps rejects do not count (shading_core/alpha_trace.glsl). Stackless: the
 // uniform control flow suits SIMD CPUs (lavapipe) and keeps register pressure low on GPUs.
 Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     Hit hit;

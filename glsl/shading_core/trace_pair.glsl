@@ -3,7 +3,7 @@
 // llvmpipe runs 8 lanes in lockstep, executes every branch of a loop body under a mask and loads
 // divergent buffer elements one lane and one word at a time, so the cost of a traversal is its
 // loop iterations times the words it loads; a pair shares both (docs/performance.md).
-// Expects the scene buffers (scene_bindings.glsl). Twin: trace_pair in crates/shading-core/src/bvh.rs.
+// Expects the scene buffers (interface/scene_bindings.glsl). Twin: trace_pair in crates/shading-core/src/bvh.rs.
 #ifndef TRACE_PAIR_GLSL
 #define TRACE_PAIR_GLSL
 

@@ -1,4 +1,4 @@
-//! GLSL alpha testing in traversal (glsl/alpha.glsl inside `bvh_traverse` and `trace_pair`)
+//! GLSL alpha testing in traversal (glsl/shading_core/alpha.glsl inside `bvh_traverse` and `trace_pair`)
 //! against its Rust twins (crates/shading-core/src/alpha.rs `alpha_keeps` and `alpha_hash`,
 //! crates/shading-core/src/bvh.rs `bvh_traverse` and `trace_pair`, crates/shading-core/src/texture.rs
 //! `material_alpha`) on random triangles with opaque, MASK (textured and not) and BLEND

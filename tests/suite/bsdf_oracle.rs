@@ -1,4 +1,4 @@
-//! GLSL bsdf.glsl against crates/shading-core/src/bsdf.rs: bsdf_eval_pdf and bsdf_sample (through
+//! GLSL glsl/shading_core/bsdf.glsl against crates/shading-core/src/bsdf.rs: bsdf_eval_pdf and bsdf_sample (through
 //! bsdf_sample_frame, sample_smooth_dielectric and sample_rough_dielectric) on random materials,
 //! normals, directions and uniforms, plus sample/pdf consistency of the Rust model.
 

@@ -1,4 +1,4 @@
-//! GLSL bvh.glsl, lights.glsl and camera.glsl against their Rust twins on a non-trivial scene:
+//! GLSL glsl/shading_core/bvh.glsl, glsl/shading/lights.glsl and glsl/scene/camera.glsl against their Rust twins on a non-trivial scene:
 //! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
 
 use std::sync::Arc;
@@ -229,7 +229,7 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
 }
 
 /// The environment half of light sampling with an equirectangular map (the scene's emitters beside
-/// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (lights.glsl, compiled
+/// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (glsl/shading/lights.glsl, compiled
 /// with the scene's SCENE_ENV_MAP defines) against their Rust twins in crates/shading/src/lights.rs.
 /// Run unrotated and turned by 37 degrees (`--env-rotation`, the header's cosine and sine).
 #[test]

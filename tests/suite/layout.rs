@@ -114,7 +114,7 @@ fn check_layout(kernel: &str, defines: &[(&str, &str)], structs: Vec<StructLayou
     checked
 }
 
-/// The records of set 1 (glsl/surface_bindings.glsl): per-triangle attributes, whose normals'
+/// The records of set 1 (glsl/interface/surface_bindings.glsl): per-triangle attributes, whose normals'
 /// w carries the packed COLOR_0 (`surface::pack_vertex_color`), and the texture records.
 fn surface_structs() -> Vec<StructLayout> {
     use restir_pt::shading::surface::TriangleSurface;

@@ -1,4 +1,4 @@
-//! GLSL glsl/shift.glsl against its Rust twins in crates/shading/src/shift/: the forward shifts
+//! GLSL glsl/shading/shift.glsl against its Rust twins in crates/shading/src/shift/: the forward shifts
 //! (shift_reconnection, shift_random_replay, shift_hybrid) on base paths, and the inverse shifts
 //! (inverse_reconnection, inverse_random_replay, inverse_hybrid) on the paths the Rust forward
 //! shifts made, carried back to the base's primary hit, as the reuse passes' MIS weights use them.

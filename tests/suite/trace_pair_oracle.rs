@@ -1,4 +1,4 @@
-//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (crates/shading-core/src/bvh.rs), in
+//! GLSL `trace_pair` (glsl/shading_core/trace_pair.glsl) against its Rust twin `trace_pair` (crates/shading-core/src/bvh.rs), in
 //! both forms: the BVH traversed once for a closest-hit and a shadow ray, and the brute-force
 //! pass of small uniform-buffer scenes; and the twin against `trace_closest`/`trace_occluded`.
 

@@ -1,4 +1,4 @@
-//! Host twins of the records in glsl/types.glsl; `#[repr(C)]` so that a test can check offsets.
+//! Host twins of the records in glsl/interface/types.glsl; `#[repr(C)]` so that a test can check offsets.
 //! Positions are in scene coordinates: world space moved by -`Scene::origin`
 //! (`restir_pt_scene::Scene`).
 
@@ -22,7 +22,7 @@ pub const MATERIAL_BLEND_EMISSION: u32 = 8;
 /// [`Triangle::emitter`] of a triangle that emits nothing.
 pub const NO_EMITTER: u32 = u32::MAX;
 
-/// A material's constant factors, as the kernels read them (glsl/types.glsl `Material`, 64 bytes,
+/// A material's constant factors, as the kernels read them (glsl/interface/types.glsl `Material`, 64 bytes,
 /// std430); textures scale them per hit (see `restir_pt_shading::texture`). The BSDF built from it is
 /// described in docs/materials.md.
 #[repr(C)]
@@ -57,7 +57,7 @@ pub struct Material {
 }
 
 /// A triangle in scene coordinates, stored as vertex 0 and two edges so that the ray-triangle test
-/// (Möller-Trumbore) needs no subtraction (glsl/types.glsl `Triangle`, 48 bytes, std430). The
+/// (Möller-Trumbore) needs no subtraction (glsl/interface/types.glsl `Triangle`, 48 bytes, std430). The
 /// counter-clockwise winding v0, v0 + e1, v0 + e2 defines the front face.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -74,12 +74,12 @@ pub struct Triangle {
     pub e2: [f32; 3],
     /// 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0, set by
     /// `restir_pt_scene::Scene::build`: the traversal loops tell alpha-tested hits apart by it
-    /// without loading materials (glsl/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
+    /// without loading materials (glsl/shading_core/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
     pub alpha_tested: u32,
 }
 
 /// A node of the BVH in depth-first order with skip links, for stackless traversal
-/// (glsl/types.glsl `BvhNode`, 32 bytes, std430): on a box hit an interior node continues at the
+/// (glsl/interface/types.glsl `BvhNode`, 32 bytes, std430): on a box hit an interior node continues at the
 /// next node (its left child) and a leaf tests its triangles and continues at `skip`; on a miss
 /// traversal continues at `skip`. A `skip` equal to the node count ends the traversal.
 #[repr(C)]
@@ -108,7 +108,7 @@ impl BvhNode {
     }
 }
 
-/// One light that next-event estimation can choose (glsl/types.glsl `Emitter`, 16 bytes, std430):
+/// One light that next-event estimation can choose (glsl/interface/types.glsl `Emitter`, 16 bytes, std430):
 /// the emissive triangles first (a triangle's [`Triangle::emitter`] is its row), then the point
 /// and spot lights, then the directional lights. The lights before the directional ones are the
 /// leaves of the light tree ([`LightNode`]); each row keeps the path from the tree's root to its
@@ -148,7 +148,7 @@ impl Emitter {
 /// bits are the light's index in `Scene::lights`. Triangle indices stay below 2^26.
 pub const PUNCTUAL_LIGHT_BIT: u32 = 1 << 31;
 
-/// Rows of the emitter buffer per punctual light, after the light tree (glsl/types.glsl):
+/// Rows of the emitter buffer per punctual light, after the light tree (glsl/interface/types.glsl):
 /// (position, kind), (direction, cos outer), (intensity, cos inner), (emitter row, 0, 0, 0).
 pub const PUNCTUAL_ROWS: usize = 4;
 
@@ -167,7 +167,7 @@ pub const LIGHT_TREE_MAX_DEPTH: usize = 32;
 /// their largest radiant intensities, and the cone of their emission directions: every light
 /// below emits only along directions within θ_o + θ_e of `axis` (θ_o bounds the lights'
 /// normals or spot axes, θ_e the spread about each). Depth-first: an interior node's first child
-/// follows it, `child` is its second. glsl/light_tree.glsl reads it as [`LIGHT_NODE_ROWS`] rows.
+/// follows it, `child` is its second. glsl/shading/light_tree.glsl reads it as [`LIGHT_NODE_ROWS`] rows.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct LightNode {
@@ -232,7 +232,7 @@ impl Triangle {
 /// (glsl/path_tracer.glsl) instead of only at `max_depth`.
 pub const FLAG_RUSSIAN_ROULETTE: u32 = 1;
 
-/// Binding 0 of every scene kernel (glsl/scene_bindings.glsl), std430 with only vec4-sized rows.
+/// Binding 0 of every scene kernel (glsl/interface/scene_bindings.glsl), std430 with only vec4-sized rows.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct FrameParams {
@@ -270,7 +270,7 @@ pub struct FrameParams {
 
 pub use crate::shader_interface::RESTIR_MAX_PASSES;
 
-/// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: the frame's reuse
+/// Binding 5 of the ReSTIR kernels (glsl/interface/restir_bindings.glsl), std430: the frame's reuse
 /// parameters and its pass table.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -317,7 +317,7 @@ pub struct ReuseParams {
     pub passes: [RestirPass; RESTIR_MAX_PASSES],
 }
 
-/// A pixel's primary hit in one frame (glsl/restir_bindings.glsl).
+/// A pixel's primary hit in one frame (glsl/interface/restir_bindings.glsl).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Surface {
@@ -331,7 +331,7 @@ pub struct Surface {
     pub depth: f32,
 }
 
-/// The first half of a stored reservoir (glsl/reservoir.glsl).
+/// The first half of a stored reservoir (glsl/shading_core/reservoir.glsl).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ReservoirHead {
@@ -353,7 +353,7 @@ pub struct ReservoirHead {
     pub rc_geometry: f32,
 }
 
-/// The second half of a stored reservoir, with W and M (glsl/reservoir.glsl).
+/// The second half of a stored reservoir, with W and M (glsl/shading_core/reservoir.glsl).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ReservoirTail {
@@ -375,11 +375,11 @@ pub struct ReservoirTail {
     pub pad1: u32,
 }
 
-/// The per-frame counters of the ReSTIR kernels (glsl/restir_bindings.glsl).
+/// The per-frame counters of the ReSTIR kernels (glsl/interface/restir_bindings.glsl).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct RestirStats {
-    /// The most iterations any subgroup's guarded loop ran (glsl/loop_budget.glsl).
+    /// The most iterations any subgroup's guarded loop ran (glsl/interface/loop_budget.glsl).
     pub max_loop_iterations: u32,
     /// Subgroups whose loop hit the iteration budget and was cut short (reported as
     /// `restir_pt_vk::error::GpuError::LoopLimit`).

@@ -71,7 +71,7 @@ macro_rules! binding_family {
 }
 
 binding_family! {
-    /// Bindings 0-4 of every scene kernel (glsl/scene_bindings.glsl): the frame parameters and
+    /// Bindings 0-4 of every scene kernel (glsl/interface/scene_bindings.glsl): the frame parameters and
     /// the scene arrays. The scene arrays are storage or uniform buffers (`SceneGpu::uniform`).
     SceneBinding, "SCENE_BINDING_", set 0 {
         /// `gpu_types::FrameParams`, a host-written storage buffer.
@@ -101,7 +101,7 @@ binding_family! {
 }
 
 binding_family! {
-    /// Bindings 5-18 of the ReSTIR PT kernels (glsl/restir_bindings.glsl), storage buffers.
+    /// Bindings 5-18 of the ReSTIR PT kernels (glsl/interface/restir_bindings.glsl), storage buffers.
     /// Surfaces alternate between frames; reservoir slots rotate within and between frames
     /// (src/render/frame_plan.rs), each slot a head and a tail buffer.
     RestirBinding, "RESTIR_BINDING_", set 0 {
@@ -138,7 +138,7 @@ binding_family! {
 
 binding_family! {
     /// Descriptor set 1 of scene kernels whose scene has surface attributes or textures
-    /// (glsl/surface_bindings.glsl, src/render/surface_gpu.rs), storage buffers. Set 0 keeps
+    /// (glsl/interface/surface_bindings.glsl, src/render/surface_gpu.rs), storage buffers. Set 0 keeps
     /// what traversal reads; these are read only at hits. Oracle kernels that bind everything
     /// in set 0 move the family there (`SURFACE_SET`, `SURFACE_BINDING` in the GLSL).
     SurfaceBinding, "SURFACE_BINDING_", set 1 {
@@ -277,12 +277,12 @@ pub const MAX_INPUTS: u32 = MAX_NEIGHBOURS + 1;
 pub const IMAGE_LOCAL_SIZE: u32 = 8;
 /// Russian roulette starts at path vertex x_3 (x_1 the primary hit): the path tracer decides
 /// there, after its NEE, whether to trace on; ReSTIR PT's initial candidates decide before
-/// their NEE at x_3 (glsl/restir_candidates.glsl). The first two bounces always continue.
+/// their NEE at x_3 (glsl/shading/candidates.glsl). The first two bounces always continue.
 pub const RR_START_DEPTH: u32 = 3;
 /// Russian roulette's survival probability is the path throughput's largest channel, at most
 /// this, so that paths of throughput near 1 (closed scenes of albedo near 1) still end.
 pub const RR_MAX_SURVIVAL: f32 = 0.95;
-/// Profile counters of glsl/counters.glsl, in its order (COUNTER_TRAVERSALS ...
+/// Profile counters of glsl/interface/counters.glsl, in its order (COUNTER_TRAVERSALS ...
 /// COUNTER_STEP_ITERATIONS), each a 64-bit sum.
 pub const COUNTER_COUNT: usize = 7;
 

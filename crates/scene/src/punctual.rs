@@ -9,7 +9,7 @@ use restir_pt_interface::gpu_types::Emitter;
 use super::gltf_loader::{problem, Loader};
 use super::luminance;
 
-/// The kind of a punctual light; the values are those of glsl/types.glsl.
+/// The kind of a punctual light; the values are those of glsl/interface/types.glsl.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PunctualKind {
     /// Emits the same intensity in every direction from `position`.

@@ -1,4 +1,4 @@
-//! The material model, twin of glsl/bsdf.glsl: a linear blend of a Lambertian lobe under a GGX
+//! The material model, twin of glsl/shading_core/bsdf.glsl: a linear blend of a Lambertian lobe under a GGX
 //! specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric
 //! (docs/materials.md). Directions point away from the surface.
 
@@ -24,7 +24,7 @@ pub fn index_matched(eta: f32) -> bool {
 }
 
 /// Lobe bits of a sampled direction ([`BsdfSample::lobe`], `PathRecord::lobes`); shared with
-/// glsl/bsdf.glsl. No lobe: a failed sample, or a vertex whose successor NEE chose.
+/// glsl/shading_core/bsdf.glsl. No lobe: a failed sample, or a vertex whose successor NEE chose.
 pub const LOBE_NONE: u32 = 0;
 /// The Lambertian base of the non-metal part.
 pub const LOBE_DIFFUSE: u32 = 1;
@@ -38,7 +38,7 @@ pub const LOBE_DELTA: u32 = 8;
 /// Set with [`LOBE_DIELECTRIC`] when the direction crossed the surface (refraction).
 pub const LOBE_TRANSMISSION: u32 = 16;
 
-/// A direction sampled from the BSDF (twin of GLSL `BsdfSample`, glsl/bsdf.glsl). A failed
+/// A direction sampled from the BSDF (twin of GLSL `BsdfSample`, glsl/shading_core/bsdf.glsl). A failed
 /// sample has zero `weight`, zero `pdf` and [`LOBE_NONE`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSample {

@@ -1,4 +1,4 @@
-//! The stackless BVH traversal twin of glsl/bvh.glsl, the oracle for GPU hits, over the
+//! The stackless BVH traversal twin of glsl/shading_core/bvh.glsl, the oracle for GPU hits, over the
 //! depth-first nodes with skip links that `restir_pt_scene::bvh` builds.
 
 use glam::{Vec2, Vec3};
@@ -8,10 +8,10 @@ use restir_pt_interface::gpu_types::{BvhNode, Triangle};
 use crate::alpha::AlphaScene;
 use crate::ray_offset::offset_ray_origin;
 
-/// The triangle index of a miss (and of an escaped path vertex); shared with glsl/bvh.glsl.
+/// The triangle index of a miss (and of an escaped path vertex); shared with glsl/shading_core/bvh.glsl.
 pub const NO_HIT: u32 = u32::MAX;
 
-/// A ray's hit (twin of GLSL `Hit`, glsl/bvh.glsl).
+/// A ray's hit (twin of GLSL `Hit`, glsl/shading_core/bvh.glsl).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit: distance along the ray in units of |d| (scene units for a unit d).
@@ -127,7 +127,7 @@ pub const SEGMENT_EPSILON: f32 = 1e-4;
 
 /// Whether anything blocks the segment between surface points p (normal np, on triangle index
 /// tp) and q (normal nq, on triangle index tq): the ray of `segment_ray`, traced (the kernels
-/// trace it inside `visibility_ray` of glsl/shift_vertex.glsl). Both ends are offset off their
+/// trace it inside `visibility_ray` of glsl/shading/shift/vertex.glsl). Both ends are offset off their
 /// surfaces, each towards the other: offsetting one end only moves a grazing far hit by more
 /// than any epsilon.
 #[allow(clippy::too_many_arguments)]
@@ -152,7 +152,7 @@ pub struct PairRay {
 /// loops cost more than the triangle tests they save (docs/performance.md).
 pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 64;
 
-/// Twin of GLSL `trace_pair` (glsl/trace_pair.glsl): the closest hit of `closest` and whether
+/// Twin of GLSL `trace_pair` (glsl/shading_core/trace_pair.glsl): the closest hit of `closest` and whether
 /// anything blocks `shadow`, in one traversal of the BVH (or, with `brute_force`, one pass over
 /// every triangle in index order, the closest hit being the first of equal distances). The BVH
 /// form tests each ray against the same triangles in the same order as `bvh_traverse`, so its

@@ -1,5 +1,5 @@
 //! The path sample a reservoir stores: everything the shifts need to rebuild or reconnect a path,
-//! and no more. 80 bytes, `#[repr(C)]` for the GPU twin to come (glsl/path_record.glsl).
+//! and no more. 80 bytes, `#[repr(C)]` for the GPU twin to come (glsl/shading_core/path_record.glsl).
 //!
 //! Random replay needs the seed, the length, the end type and the lobes (to check that the
 //! replayed path has the same vertex types). Reconnection and hybrid also need the reconnection
@@ -16,7 +16,7 @@ const INFO_RC_SHIFT: u32 = 4;
 const INFO_NEE_END: u32 = 1 << 8;
 const INFO_DIRECTIONAL_SHIFT: u32 = 9;
 
-/// A reservoir's path sample (glsl/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
+/// A reservoir's path sample (glsl/shading_core/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
 /// GPU split into [`restir_pt_interface::gpu_types::ReservoirHead`] and [`restir_pt_interface::gpu_types::ReservoirTail`]).
 /// x_0 is the camera, x_1..x_k the path's vertices, x_r the reconnection vertex; positions and
 /// directions are in scene coordinates, colours linear RGB.

@@ -1,5 +1,5 @@
 //! Per-triangle surface attributes (vertex normals, tangents, texture coordinates) and the
-//! surface of a hit built from them. Twin of glsl/surface.glsl: `surface_at` has a GLSL function
+//! surface of a hit built from them. Twin of glsl/shading_core/surface.glsl: `surface_at` has a GLSL function
 //! of the same name, compared in tests/suite/surface_oracle.rs.
 //!
 //! The attributes live in their own array, parallel to the triangles (same BVH order) and read
@@ -15,7 +15,7 @@ use restir_pt_interface::gpu_types::Triangle;
 use crate::sampling::build_onb;
 
 /// The attributes of one triangle's three vertices (v0, v0 + e1, v0 + e2), in scene space
-/// (the triangles' coordinates), std430 layout of `TriangleSurface` in glsl/surface.glsl.
+/// (the triangles' coordinates), std430 layout of `TriangleSurface` in glsl/shading_core/surface.glsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct TriangleSurface {
