@@ -246,6 +246,8 @@ fn compare_alpha_oracle(scene: &Scene, inputs: &[Vec4], out: &[Vec4], brute_forc
 /// their threshold (at most 1% of rays are set aside so).
 #[test]
 fn alpha_traversal_glsl_matches_rust() {
+    // GLSL bvh_traverse, trace_pair, alpha_hash, alpha_keeps and material_alpha of a scene with alpha
+    // tests against their Rust twins (compare_alpha_oracle).
     let scene = alpha_random_scene(21, 600, 5.0, false);
     let inputs = alpha_oracle_inputs(&scene, 22, 5.0);
     let out = run_alpha_oracle(&scene, &inputs, false);

@@ -83,6 +83,7 @@ fn near_decision(m: &Material, ng: Vec3, ns: Vec3, wo: Vec3, u: Vec4) -> bool {
 
 #[test]
 fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
+    // GLSL bsdf_eval_pdf and bsdf_sample against their Rust twins (check_bsdf_item).
     let ctx = gpu();
     let mut r = TestRng(99);
     let n_items = 1 << 14;

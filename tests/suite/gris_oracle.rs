@@ -155,6 +155,7 @@ fn check_mis_weight(mis: Mis) {
 
 #[test]
 fn gris_mis_weight_generalized_balance_glsl_matches_rust() {
+    // GLSL mis_weight against its Rust twin.
     check_mis_weight(Mis::GeneralizedBalance);
 }
 

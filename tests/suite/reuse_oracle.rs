@@ -277,6 +277,7 @@ fn check_glsl_matches_rust(mis: Mis) {
 
 #[test]
 fn resample_inputs_generalized_balance_glsl_matches_rust() {
+    // GLSL resample_inputs against its Rust twin on the toy bridge.
     check_glsl_matches_rust(Mis::GeneralizedBalance);
 }
 

@@ -272,30 +272,36 @@ fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
 
 #[test]
 fn shift_reconnection_glsl_matches_rust() {
+    // GLSL shift_reconnection against its Rust twin.
     check_glsl_matches_rust(Kind::Reconnection, false);
 }
 
 #[test]
 fn shift_random_replay_glsl_matches_rust() {
+    // GLSL shift_random_replay against its Rust twin.
     check_glsl_matches_rust(Kind::RandomReplay, false);
 }
 
 #[test]
 fn shift_hybrid_glsl_matches_rust() {
+    // GLSL shift_hybrid against its Rust twin.
     check_glsl_matches_rust(Kind::Hybrid, false);
 }
 
 #[test]
 fn inverse_reconnection_glsl_matches_rust() {
+    // GLSL inverse_reconnection against its Rust twin.
     check_glsl_matches_rust(Kind::Reconnection, true);
 }
 
 #[test]
 fn inverse_random_replay_glsl_matches_rust() {
+    // GLSL inverse_random_replay against its Rust twin.
     check_glsl_matches_rust(Kind::RandomReplay, true);
 }
 
 #[test]
 fn inverse_hybrid_glsl_matches_rust() {
+    // GLSL inverse_hybrid against its Rust twin.
     check_glsl_matches_rust(Kind::Hybrid, true);
 }

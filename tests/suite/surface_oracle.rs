@@ -155,6 +155,8 @@ fn near_texel_edge(h: &TextureHeader, uv: Vec2) -> bool {
 
 #[test]
 fn surface_at_texture_lookup_textured_material_normal_mapped_glsl_matches_rust() {
+    // GLSL surface_at, triangle_bary, texture_lookup, texture_coordinates, texture_tangent_frame,
+    // textured_material, normal_mapped, shading_normal and hit_shading against their Rust twins (check_item).
     compare_surfaces(&gpu(), &textured_random_scene(7));
 }
 

@@ -121,6 +121,7 @@ fn trace_pair_glsl_matches_rust_bvh_addressed() {
 
 #[test]
 fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
+    // GLSL trace_pair against its Rust twin (assert_gpu_matches_twin).
     let ctx = gpu();
     let big = random_scene(5);
     let pairs = random_pairs(6, Vec3::ZERO, 6.0);
