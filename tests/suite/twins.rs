@@ -180,14 +180,14 @@ fn test_body<'a>(source: &'a str, name: &str) -> Option<&'a str> {
     Some(&rest[..rest.find("\n}").unwrap_or(rest.len())])
 }
 
-/// The files under `dir` (a path from the repository's root) whose names end in `ext`.
+/// The files under `dir` (a path from the repository's root) with the extension `ext`.
 fn files_under(dir: &str, ext: &str, out: &mut Vec<String>) {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
     for entry in std::fs::read_dir(folder).expect("readable folder").flatten() {
         let name = format!("{dir}/{}", entry.file_name().to_string_lossy());
         if entry.path().is_dir() {
             files_under(&name, ext, out);
-        } else if name.ends_with(ext) {
+        } else if entry.path().extension().is_some_and(|e| e == ext) {
             out.push(name);
         }
     }
@@ -221,8 +221,8 @@ fn twins_every_same_named_pair_is_in_the_table_or_compared_through_it() {
     let mut pairs = Vec::new();
     for &(folder, krate) in MIRRORS {
         let (mut rust_files, mut glsl_files) = (Vec::new(), Vec::new());
-        files_under(&format!("crates/{krate}/src"), ".rs", &mut rust_files);
-        files_under(&format!("glsl/{folder}"), ".glsl", &mut glsl_files);
+        files_under(&format!("crates/{krate}/src"), "rs", &mut rust_files);
+        files_under(&format!("glsl/{folder}"), "glsl", &mut glsl_files);
         let rust: String = rust_files.iter().map(|f| read(f)).collect();
         for file in glsl_files {
             let file = file.strip_prefix("glsl/").expect("under glsl/").to_string();
