@@ -2,20 +2,20 @@
 // one light drawn, plus every directional light, add_directional_lights), written
 // as a per-segment state machine: a kernel steps every lane once per iteration and restarts lanes
 // whose path ended, so SIMD lanes (lavapipe runs 8 in lockstep) stay busy however long paths are.
-// Each step traces one pair of rays in one traversal (trace_pair.glsl): the next segment and the
+// Each step traces one pair of rays in one traversal (shading_core/trace_pair.glsl): the next segment and the
 // shadow ray of the vertex before it, whose NEE contribution waits in the state until then.
 // max_depth counts path segments: 1 shows emitters seen directly, 2 adds direct lighting.
 #ifndef PATH_TRACER_GLSL
 #define PATH_TRACER_GLSL
 
-#include "bsdf.glsl"
-#include "bvh.glsl"
-#include "camera.glsl"
-#include "lights.glsl"
-#include "punctual.glsl"
-#include "rng.glsl"
-#include "shading_frame.glsl"
-#include "trace_pair.glsl"
+#include "shading_core/bsdf.glsl"
+#include "shading_core/bvh.glsl"
+#include "scene/camera.glsl"
+#include "shading/lights.glsl"
+#include "shading/punctual.glsl"
+#include "shading_core/rng.glsl"
+#include "scene/hit_surface.glsl"
+#include "shading_core/trace_pair.glsl"
 
 const float RAY_TMAX = 1e30;
 
@@ -72,7 +72,7 @@ PathState path_begin(uvec2 pixel, uint seed) {
 
 // Adds to s.radiance what every directional light sends through the vertex x (geometric normal
 // ng, on triangle index tri; material m, shading normal ns, towards wo): NEE takes each of them
-// beside the light sample_light draws (light_tree.glsl), one shadow ray each, traced at once.
+// beside the light sample_light draws (shading/light_tree.glsl), one shadow ray each, traced at once.
 void add_directional_lights(inout PathState s, vec3 x, vec3 ng, uint tri, Material m, vec3 ns, vec3 wo) {
 #if SCENE_PUNCTUAL && SCENE_DIRECTIONAL
     uint n_dir = directional_count();

@@ -7,7 +7,7 @@
 
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
-#include "scene_bindings.glsl"
+#include "interface/scene_bindings.glsl"
 #include "path_tracer.glsl"
 
 layout(std430, set = 0, binding = PATHTRACE_BINDING_ACCUM) buffer Accum { vec4 accum[]; };       // rgb: sum of L, w: count
@@ -17,7 +17,7 @@ layout(std430, set = 0, binding = PATHTRACE_BINDING_STATUS) buffer Status {
     uint loop_budget_cut_groups;
     uint nonfinite_paths;           // paths whose radiance or throughput is NaN or infinite
     uint status_pad;                // std430 aligns the uvec2 array below to 8 bytes
-    uvec2 counters[COUNTER_COUNT];  // 64-bit totals (low, high) of counters.glsl
+    uvec2 counters[COUNTER_COUNT];  // 64-bit totals (low, high) of interface/counters.glsl
     uint subgroup_lanes;
 };
 

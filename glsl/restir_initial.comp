@@ -1,6 +1,6 @@
 #version 460
 // ReSTIR PT pass 1: the pixel's surface (its hit through the pixel's centre), the emission seen
-// directly and the initial reservoir from `initial.candidates` traced paths (restir_candidates.glsl),
+// directly and the initial reservoir from `initial.candidates` traced paths (shading/candidates.glsl),
 // each through its own sub-pixel position.
 #extension GL_GOOGLE_include_directive : require
 
@@ -8,9 +8,9 @@
 
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
-#include "restir_bindings.glsl"
-#include "restir_candidates.glsl"
-#include "camera.glsl"
+#include "interface/restir_bindings.glsl"
+#include "shading/candidates.glsl"
+#include "scene/camera.glsl"
 
 // The radiance a camera ray from `camera` in `dir` receives directly from what it hits (or
 // escapes to): end_emission of the one-segment path.

@@ -1,6 +1,6 @@
 // GRIS across pixels and frames (docs/restir.md): the domains of ReSTIR PT's reservoirs (a pixel
 // seen from a frame's camera) and the shifts between them, the bridge on which the reuse loop
-// (resample_inputs.glsl) runs: input_reservoir, input_domain, same_domain and shift_path.
+// (shading/resample_inputs.glsl) runs: input_reservoir, input_domain, same_domain and shift_path.
 // SHIFT_MODE and MIS_MODE select the shift and the MIS at compile time.
 #ifndef RESTIR_REUSE_GLSL
 #define RESTIR_REUSE_GLSL
@@ -8,10 +8,10 @@
 // Every traversal of a reuse kernel belongs to a shift; counting them gives rays per shift.
 #define COUNT_TRAVERSALS 1
 
-#include "restir_bindings.glsl"
-#include "camera.glsl"
-#include "gris.glsl"
-#include "shift.glsl"
+#include "interface/restir_bindings.glsl"
+#include "scene/camera.glsl"
+#include "shading_core/gris.glsl"
+#include "shading/shift.glsl"
 
 #ifndef SHIFT_MODE
 #define SHIFT_MODE SHIFT_HYBRID
@@ -29,7 +29,7 @@ struct Domain {
 };
 
 // One input of a resampling: the reservoir at `index` of reservoir slot `slot`, of `domain`; its
-// confidence weight c is `confidences` (gris.glsl) at the same index. The reservoir stays in its
+// confidence weight c is `confidences` (shading_core/gris.glsl) at the same index. The reservoir stays in its
 // buffer until it is resampled: lavapipe turns a run-time index into a local array into selects
 // over every element, so an array of whole reservoirs cost more compile and run time than the
 // loads.
@@ -122,7 +122,7 @@ ShiftResult shift_path(PathRecord record, Domain to) {
 }
 
 // The reuse loop, on the bridge above.
-#include "resample_inputs.glsl"
+#include "shading/resample_inputs.glsl"
 
 // Whether a neighbour's primary hit is similar enough to the canonical one to be reused: both
 // hit a surface, normals agree, and the neighbour's depth agrees with the canonical point's

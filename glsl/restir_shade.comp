@@ -9,7 +9,7 @@
 
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
-#include "restir_bindings.glsl"
+#include "interface/restir_bindings.glsl"
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;

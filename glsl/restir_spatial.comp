@@ -8,7 +8,7 @@
 layout(local_size_x = IMAGE_LOCAL_SIZE, local_size_y = IMAGE_LOCAL_SIZE) in;
 
 #include "restir_reuse.glsl"
-#include "sampling.glsl"
+#include "shading_core/sampling.glsl"
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;

@@ -123,7 +123,7 @@ struct Triangle {
     vec3 e1;                         // Vertex 1 minus vertex 0, scene coordinates.
     uint emitter;                    // Index into the emitter table, or `NO_EMITTER` if the triangle does not emit.
     vec3 e2;                         // Vertex 2 minus vertex 0, scene coordinates.
-    uint alpha_tested;               // 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0, set by `restir_pt_scene::Scene::build`: the traversal loops tell alpha-tested hits apart by it without loading materials (glsl/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
+    uint alpha_tested;               // 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0, set by `restir_pt_scene::Scene::build`: the traversal loops tell alpha-tested hits apart by it without loading materials (glsl/shading_core/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
 };
 
 struct BvhNode {

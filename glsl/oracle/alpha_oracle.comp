@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: alpha testing in traversal (glsl/alpha.glsl inside bvh_traverse and
+// Oracle kernel: alpha testing in traversal (glsl/shading_core/alpha.glsl inside bvh_traverse and
 // trace_pair) on a scene with MASK and BLEND materials (twins: crates/shading-core/src/alpha.rs,
 // crates/shading-core/src/bvh.rs, crates/shading-core/src/texture.rs). Compiled with the scene's defines, SCENE_ALPHA
 // among them. Everything is bound in set 0: the scene at 0-4, the surface bindings at 5-8, then
@@ -9,8 +9,8 @@ layout(local_size_x = 64) in;
 
 #define SURFACE_SET 0
 #define SURFACE_BINDING 5
-#include "../scene_bindings.glsl"
-#include "../trace_pair.glsl"
+#include "interface/scene_bindings.glsl"
+#include "shading_core/trace_pair.glsl"
 
 // Per item: (origin, shadow tmax), (direction, -), (triangle bits, b1, b2, -).
 layout(std430, set = 0, binding = 9) readonly buffer Inputs { vec4 inputs[]; };

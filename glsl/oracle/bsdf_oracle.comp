@@ -4,7 +4,7 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../bsdf.glsl"
+#include "shading_core/bsdf.glsl"
 
 layout(std430, set = 0, binding = 0) readonly buffer Materials { Material materials[]; };
 // Per item: geometric normal, shading normal, wo, wi (xyz), u.

@@ -1,18 +1,18 @@
 #version 460
 // Oracle kernel: the initial candidates of one traced path per item (stream_path_candidates of
-// restir_candidates.glsl) streamed into a fresh Resampler, from primary hits and seeds the host
+// shading/candidates.glsl) streamed into a fresh Resampler, from primary hits and seeds the host
 // chose, with Russian roulette where the frame parameters' flags ask for it. Twin:
 // stream_path_candidates in crates/shading/src/candidates.rs.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../scene_bindings.glsl"
+#include "interface/scene_bindings.glsl"
 
-// The pass counters restir_candidates.glsl expects (restir_bindings.glsl in the kernels).
+// The pass counters shading/candidates.glsl expects (interface/restir_bindings.glsl in the kernels).
 uint local_nonfinite_weights = 0u;
 uint local_candidates_dropped = 0u;
 
-#include "../restir_candidates.glsl"
+#include "shading/candidates.glsl"
 
 // x: the longest path, y: roughness threshold, z: distance threshold, w: the candidates' MIS
 // scale (float bits).

@@ -1,12 +1,12 @@
 #version 460
-// Oracle kernel: the resampling MIS weights (gris.glsl, MIS_MODE as compiled) and the streaming
-// resampler (reservoir.glsl) on inputs the host recorded, one resampling per item
+// Oracle kernel: the resampling MIS weights (shading_core/gris.glsl, MIS_MODE as compiled) and the streaming
+// resampler (shading_core/reservoir.glsl) on inputs the host recorded, one resampling per item
 // (twins: crates/shading-core/src/gris.rs mis_weight, resampler_begin, resampler_offer, resampler_finish).
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../gris.glsl"
-#include "../reservoir.glsl"
+#include "shading_core/gris.glsl"
+#include "shading_core/reservoir.glsl"
 
 // Per item: the number of inputs n, their confidences c_l, and for each input i the row
 // p̂_{<-l}(y_i), l = 0..n-1.

@@ -1,5 +1,5 @@
 #version 460
-// Oracle kernel: the reuse loop (resample_inputs.glsl, MIS_MODE as compiled) on the analytic
+// Oracle kernel: the reuse loop (shading/resample_inputs.glsl, MIS_MODE as compiled) on the analytic
 // domains of the GRIS toy (tests/suite/gris.rs), one resampling per item. Twin: resample_inputs
 // in crates/shading/src/resample_inputs.rs on the same bridge (ToyDomains in tests/suite/reuse_oracle.rs).
 //
@@ -10,8 +10,8 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../reservoir.glsl"
-#include "../shift_result.glsl"
+#include "shading_core/reservoir.glsl"
+#include "shading/shift/result.glsl"
 
 struct Domain {
     uint index;
@@ -88,7 +88,7 @@ ShiftResult shift_path(PathRecord x, Domain to) {
     return s;
 }
 
-#include "../resample_inputs.glsl"
+#include "shading/resample_inputs.glsl"
 
 void main() {
     uint item = gl_GlobalInvocationID.x;

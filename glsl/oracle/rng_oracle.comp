@@ -3,7 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../rng.glsl"
+#include "shading_core/rng.glsl"
 
 layout(std430, set = 0, binding = 0) readonly buffer Inputs { uvec4 inputs[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Outputs { uvec4 outputs[]; };

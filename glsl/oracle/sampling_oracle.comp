@@ -1,9 +1,9 @@
 #version 460
-// Oracle kernel: the warps of sampling.glsl on given uniforms (twin: crates/shading-core/src/sampling.rs).
+// Oracle kernel: the warps of shading_core/sampling.glsl on given uniforms (twin: crates/shading-core/src/sampling.rs).
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../sampling.glsl"
+#include "shading_core/sampling.glsl"
 
 // Per item: u (xy used), params (xyz: direction or normal, w: alpha).
 layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };

@@ -5,11 +5,11 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../scene_bindings.glsl"
-#include "../bvh.glsl"
-#include "../camera.glsl"
-#include "../lights.glsl"
-#include "../punctual.glsl"
+#include "interface/scene_bindings.glsl"
+#include "shading_core/bvh.glsl"
+#include "scene/camera.glsl"
+#include "shading/lights.glsl"
+#include "shading/punctual.glsl"
 
 // Per item: origin (w: tmax), direction, light-sample uniforms (xyz), image point (xy).
 layout(std430, set = 0, binding = 5) readonly buffer Inputs { vec4 inputs[]; };

@@ -7,8 +7,8 @@
 layout(local_size_x = 64) in;
 
 #define SHIFT_ORACLE 1
-#include "../scene_bindings.glsl"
-#include "../shift.glsl"
+#include "interface/scene_bindings.glsl"
+#include "shading/shift.glsl"
 
 #ifndef ORACLE_SHIFT
 #error "ORACLE_SHIFT names the shift to test"

@@ -9,8 +9,8 @@ layout(local_size_x = 64) in;
 
 #define SURFACE_SET 0
 #define SURFACE_BINDING 5
-#include "../scene_bindings.glsl"
-#include "../shading_frame.glsl"
+#include "interface/scene_bindings.glsl"
+#include "scene/hit_surface.glsl"
 
 // Per item: (triangle bits, b1, b2, texture bits), (u, v, srgb, -), (point xyz, -).
 layout(std430, set = 0, binding = 9) readonly buffer Inputs { vec4 inputs[]; };

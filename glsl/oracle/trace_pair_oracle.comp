@@ -4,8 +4,8 @@
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
 
-#include "../scene_bindings.glsl"
-#include "../trace_pair.glsl"
+#include "interface/scene_bindings.glsl"
+#include "shading_core/trace_pair.glsl"
 
 // Per item: closest ray origin (w: tmax), direction, shadow ray origin (w: tmax), direction.
 layout(std430, set = 0, binding = 5) readonly buffer Inputs { vec4 inputs[]; };

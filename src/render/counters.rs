@@ -1,4 +1,4 @@
-//! Host side of glsl/counters.glsl: the profile counters a path-tracer kernel compiled with
+//! Host side of glsl/interface/counters.glsl: the profile counters a path-tracer kernel compiled with
 //! `TRAVERSAL_COUNTERS=1` sums over a dispatch (`restir-pt bench --counters`).
 
 use serde::Serialize;

@@ -92,7 +92,7 @@ impl PathTracer {
     }
 
     /// Like `new`; with `counters` the kernel also counts rays, node visits, triangle tests and
-    /// SIMD loop iterations (glsl/counters.glsl), which `render` returns in its stats.
+    /// SIMD loop iterations (glsl/interface/counters.glsl), which `render` returns in its stats.
     pub fn with_counters(scene: &Arc<SceneGpu>, settings: &RenderSettings, counters: bool) -> Result<Self> {
         let ctx = scene.ctx();
         settings.validate(scene.info())?;

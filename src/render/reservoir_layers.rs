@@ -1,5 +1,5 @@
 //! The per-reservoir buffers of ReSTIR PT: one width x height layer per reservoir of a pixel
-//! (glsl/restir_bindings.glsl's reservoir_index).
+//! (glsl/interface/restir_bindings.glsl's reservoir_index).
 
 use std::sync::Arc;
 

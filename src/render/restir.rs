@@ -55,7 +55,7 @@ fn halves_by_size(compiled: &[CompiledKernel]) -> (Vec<usize>, Vec<usize>) {
 }
 
 /// Shared memory of one workgroup of the ReSTIR kernels: the path being built by each of its
-/// LOCAL_SIZE² invocations (glsl/shift_path.glsl, `path_vertices`, `path_lobes`, `path_weights`),
+/// LOCAL_SIZE² invocations (glsl/shading/shift/path.glsl, `path_vertices`, `path_lobes`, `path_weights`),
 /// per vertex a 32-byte vertex, a lobe and a 16-byte weight row.
 const SHARED_BYTES: u32 = LOCAL_SIZE * LOCAL_SIZE * crate::shading::path_record::MAX_PATH_LENGTH as u32 * (32 + 4 + 16);
 

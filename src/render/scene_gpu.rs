@@ -1,4 +1,4 @@
-//! The uploaded scene: its buffers (bindings 1-4 of glsl/scene_bindings.glsl), the `#define`s
+//! The uploaded scene: its buffers (bindings 1-4 of glsl/interface/scene_bindings.glsl), the `#define`s
 //! that specialise scene kernels to what the scene contains, and the host data renderers read.
 //! Renderers are built from an `Arc<SceneGpu>` and share it, so one upload serves every method.
 //!
@@ -30,7 +30,7 @@ pub struct SceneGpu {
     ctx: Arc<Context>,
     /// The host data of the scene these buffers hold.
     info: SceneInfo,
-    /// `Triangle` records (glsl/types.glsl), one per scene triangle (one placeholder if none).
+    /// `Triangle` records (glsl/interface/types.glsl), one per scene triangle (one placeholder if none).
     pub triangles: Buffer,
     /// The BVH's `BvhNode` records, root first.
     pub nodes: Buffer,

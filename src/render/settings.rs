@@ -30,7 +30,7 @@ pub struct RenderSettings {
     /// Seeds every random number of the render: equal settings and seed give equal images.
     pub seed: u32,
     /// Russian roulette in the path tracer's paths and ReSTIR PT's initial candidates (never in
-    /// its shifts; glsl/restir_candidates.glsl).
+    /// its shifts; glsl/shading/candidates.glsl).
     pub russian_roulette: bool,
     /// Index into the scene's cameras.
     pub camera: usize,

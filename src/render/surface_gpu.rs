@@ -1,5 +1,5 @@
 //! The surface attributes and textures of a scene on the device: descriptor set 1 of scene
-//! kernels (glsl/surface_bindings.glsl), present only when the scene has them.
+//! kernels (glsl/interface/surface_bindings.glsl), present only when the scene has them.
 
 use std::sync::Arc;
 
@@ -15,7 +15,7 @@ use super::scene_gpu::address_record;
 /// Set 1's buffers: the per-triangle attributes, then (with textures) the material texture
 /// table, the texture headers and the texels.
 pub struct SurfaceGpu {
-    /// The set's storage buffers in binding order (glsl/surface_bindings.glsl): one without
+    /// The set's storage buffers in binding order (glsl/interface/surface_bindings.glsl): one without
     /// textures, four with them. In the addressed layout the attributes' and texels' bindings
     /// hold an address record (`scene_gpu::address_record`) in place of the array.
     pub buffers: Vec<Buffer>,

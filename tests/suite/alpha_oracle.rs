@@ -1,4 +1,4 @@
-//! GLSL alpha testing in traversal (glsl/alpha.glsl inside `bvh_traverse` and `trace_pair`)
+//! GLSL alpha testing in traversal (glsl/shading_core/alpha.glsl inside `bvh_traverse` and `trace_pair`)
 //! against its Rust twins (crates/shading-core/src/alpha.rs `alpha_keeps` and `alpha_hash`,
 //! crates/shading-core/src/bvh.rs `bvh_traverse` and `trace_pair`, crates/shading-core/src/texture.rs
 //! `material_alpha`) on random triangles with opaque, MASK (textured and not) and BLEND
@@ -246,6 +246,8 @@ fn compare_alpha_oracle(scene: &Scene, inputs: &[Vec4], out: &[Vec4], brute_forc
 /// their threshold (at most 1% of rays are set aside so).
 #[test]
 fn alpha_traversal_glsl_matches_rust() {
+    // GLSL bvh_traverse, trace_pair, alpha_hash, alpha_keeps and material_alpha of a scene with alpha
+    // tests against their Rust twins (compare_alpha_oracle).
     let scene = alpha_random_scene(21, 600, 5.0, false);
     let inputs = alpha_oracle_inputs(&scene, 22, 5.0);
     let out = run_alpha_oracle(&scene, &inputs, false);

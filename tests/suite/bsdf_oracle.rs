@@ -1,4 +1,4 @@
-//! GLSL bsdf.glsl against crates/shading-core/src/bsdf.rs: bsdf_eval_pdf and bsdf_sample (through
+//! GLSL glsl/shading_core/bsdf.glsl against crates/shading-core/src/bsdf.rs: bsdf_eval_pdf and bsdf_sample (through
 //! bsdf_sample_frame, sample_smooth_dielectric and sample_rough_dielectric) on random materials,
 //! normals, directions and uniforms, plus sample/pdf consistency of the Rust model.
 
@@ -83,6 +83,7 @@ fn near_decision(m: &Material, ng: Vec3, ns: Vec3, wo: Vec3, u: Vec4) -> bool {
 
 #[test]
 fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
+    // GLSL bsdf_eval_pdf and bsdf_sample against their Rust twins (check_bsdf_item).
     let ctx = gpu();
     let mut r = TestRng(99);
     let n_items = 1 << 14;

@@ -1,14 +1,17 @@
-//! GLSL bvh.glsl, lights.glsl and camera.glsl against their Rust twins on a non-trivial scene:
+//! GLSL glsl/shading_core/bvh.glsl, glsl/shading/lights.glsl and glsl/scene/camera.glsl against their Rust twins on a non-trivial scene:
 //! 6000 random triangles (some emissive) around a tessellated sphere, with an environment.
 
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
-use restir_pt::gpu_types::NO_EMITTER;
+use restir_pt::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::Scene;
 use restir_pt::shading::bvh::{trace_closest, trace_occluded, NO_HIT};
-use restir_pt::shading::lights::{sample_light, LightSample};
+use restir_pt::shading::light_tree::light_select_pmf;
+use restir_pt::shading::lights::{
+    emitter_pdf, environment_pdf, is_punctual_light, punctual_emitter_row, punctual_occluded, sample_light, LightSample,
+};
 use restir_pt::shading::ray_offset::offset_ray_origin;
 use restir_pt::vk::{Buffer, BufferUsage, Context};
 
@@ -19,6 +22,8 @@ const RAYS: usize = 20_000;
 
 #[test]
 fn bvh_traversal_lights_and_camera_glsl_matches_rust() {
+    // GLSL trace_closest, trace_occluded, offset_ray_origin, sample_light, environment_pdf,
+    // light_select_pmf, emitter_pdf and punctual_occluded against their Rust twins (check_scene_oracle).
     let ctx = gpu();
     let scene = random_scene_with_punctual_lights(1);
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
@@ -154,7 +159,8 @@ fn check_traversal(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize, coverage
     }
 }
 
-/// sample_light, camera_ray_dir and punctual_occluded of item `i` against their Rust twins.
+/// sample_light, the pdf of its sample, camera_ray_dir and punctual_occluded of item `i` against
+/// their Rust twins.
 fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
     let (o, d, u, px) = (input[0], input[1].truncate(), input[2].truncate(), input[3]);
     let ls = sample_light(scene, o.truncate(), d, u);
@@ -180,11 +186,29 @@ fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec
     );
     if ls.pdf > 0.0 {
         coverage.light_samples += 1;
+        // The same recomputation by the Rust twins: the emitter before is_punctual_light, since
+        // NO_EMITTER has the punctual bit set.
+        let again = if ls.triangle == NO_EMITTER {
+            environment_pdf(scene, ls.dir)
+        } else if is_punctual_light(ls.triangle) {
+            light_select_pmf(
+                scene,
+                o.truncate(),
+                d,
+                punctual_emitter_row(scene, ls.triangle & !PUNCTUAL_LIGHT_BIT),
+            )
+        } else {
+            emitter_pdf(scene, o.truncate(), d, ls.triangle, ls.dir, ls.dist)
+        };
+        assert!(
+            close(g[5].y, again, 1e-3),
+            "environment_pdf / light_select_pmf / emitter_pdf, item {i}: GLSL {} vs Rust {again}",
+            g[5].y
+        );
     }
-    if restir_pt::shading::lights::is_punctual_light(ls.triangle) {
+    if is_punctual_light(ls.triangle) {
         coverage.punctual_samples += 1;
-        let shadowed =
-            restir_pt::shading::lights::punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+        let shadowed = punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
         assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
         coverage.punctual_shadowed += shadowed as usize;
     }
@@ -229,7 +253,7 @@ fn bvh_leaves_cover_every_triangle_once_and_bound_it() {
 }
 
 /// The environment half of light sampling with an equirectangular map (the scene's emitters beside
-/// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (lights.glsl, compiled
+/// it): GLSL `sample_light`, `environment_radiance` and `environment_pdf` (glsl/shading/lights.glsl, compiled
 /// with the scene's SCENE_ENV_MAP defines) against their Rust twins in crates/shading/src/lights.rs.
 /// Run unrotated and turned by 37 degrees (`--env-rotation`, the header's cosine and sine).
 #[test]

@@ -1,4 +1,4 @@
-//! GLSL `stream_path_candidates` (glsl/restir_candidates.glsl, the initial pass's candidates)
+//! GLSL `stream_path_candidates` (glsl/shading/candidates.glsl, the initial pass's candidates)
 //! against its Rust twin `stream_path_candidates` (crates/shading/src/candidates.rs): one traced path
 //! per item from a primary hit of camera 0 with its own seed, its light-ending prefixes streamed
 //! into a fresh Resampler on both sides, with and without Russian roulette; the chosen record,

@@ -1,6 +1,6 @@
-//! GLSL against Rust for resampling: `mis_weight` of glsl/gris.glsl (generalized balance
+//! GLSL against Rust for resampling: `mis_weight` of glsl/shading_core/gris.glsl (generalized balance
 //! heuristic and pairwise MIS) against `gris::mis_weight`, and the streaming resampler of
-//! glsl/reservoir.glsl (`Resampler`, `resampler_begin`, `resampler_add`/`resampler_offer`,
+//! glsl/shading_core/reservoir.glsl (`Resampler`, `resampler_begin`, `resampler_add`/`resampler_offer`,
 //! `resampler_finish`) against its twins in crates/shading-core/src/gris.rs, on recorded inputs: tables of
 //! confidence weights and p̂_{<-l}(y_i) with failed shifts (zeros) and six decades of range, and
 //! offered candidates with zero weights and lost choices, as the reuse passes see them.
@@ -10,7 +10,7 @@ use restir_pt::shading::gris::{mis_weight, resampler_begin, resampler_finish, re
 
 use crate::common::{close, gpu, mis_mode, run_oracle_with_defines, TestRng};
 
-/// Inputs per resampling in the kernels (glsl/gris.glsl MAX_INPUTS).
+/// Inputs per resampling in the kernels (glsl/shading_core/gris.glsl MAX_INPUTS).
 const MAX_INPUTS: usize = 9;
 const CASES: usize = 4096;
 
@@ -155,6 +155,7 @@ fn check_mis_weight(mis: Mis) {
 
 #[test]
 fn gris_mis_weight_generalized_balance_glsl_matches_rust() {
+    // GLSL mis_weight against its Rust twin.
     check_mis_weight(Mis::GeneralizedBalance);
 }
 

@@ -126,7 +126,7 @@ fn check_spirv_layout(kernel: &str, spirv: &[u32], structs: Vec<StructLayout>) -
     checked
 }
 
-/// The records of set 1 (glsl/surface_bindings.glsl): per-triangle attributes, whose normals'
+/// The records of set 1 (glsl/interface/surface_bindings.glsl): per-triangle attributes, whose normals'
 /// w carries the packed COLOR_0 (`surface::pack_vertex_color`), and the texture records.
 fn surface_structs() -> Vec<StructLayout> {
     layouts(&["TriangleSurface", "TextureHeader", "TextureSlot", "MaterialTextures"])

@@ -56,3 +56,4 @@ mod surface_oracle;
 mod sweeps;
 mod textured_scenes;
 mod trace_pair_oracle;
+mod twins;

@@ -1,4 +1,4 @@
-//! Light selection by contribution (the light tree, glsl/light_tree.glsl) on the GPU:
+//! Light selection by contribution (the light tree, glsl/shading/light_tree.glsl) on the GPU:
 //! - a small lamp keeps its noise when a far light joins it: per-pixel standard deviation over
 //!   the lamp-lit ground with and without a point light 10^6 units away or a sun over a large
 //!   ground, ratio at most 2 (choosing by power made it 72);

@@ -1,5 +1,5 @@
 //! The reuse loop of ReSTIR PT on the GRIS toy's analytic domains (tests/suite/gris.rs): GLSL
-//! `resample_inputs` (glsl/resample_inputs.glsl, run by glsl/oracle/reuse_oracle.comp on the toy
+//! `resample_inputs` (glsl/shading/resample_inputs.glsl, run by glsl/oracle/reuse_oracle.comp on the toy
 //! bridge) against its twin `resample_inputs` (crates/shading/src/resample_inputs.rs on the same bridge,
 //! `ToyDomains`), the twin against the reference estimator `gris::resampled_expectation`, and
 //! the twin's f(Y) W_Y against the integral. Up to 9 inputs per resampling, from the canonical
@@ -246,6 +246,7 @@ fn check_glsl_matches_rust(mis: Mis) {
 
 #[test]
 fn resample_inputs_generalized_balance_glsl_matches_rust() {
+    // GLSL resample_inputs against its Rust twin on the toy bridge.
     check_glsl_matches_rust(Mis::GeneralizedBalance);
 }
 

@@ -1,4 +1,4 @@
-//! GLSL rng.glsl against crates/shading-core/src/rng.rs: pcg4d, path_seed and rng_uniform4 must agree bit for bit.
+//! GLSL glsl/shading_core/rng.glsl against crates/shading-core/src/rng.rs: pcg4d, path_seed and rng_uniform4 must agree bit for bit.
 
 use glam::UVec4;
 use restir_pt::shading::rng::{path_seed, pcg4d, rng_uniform4};

@@ -1,4 +1,4 @@
-//! GLSL sampling.glsl against crates/shading-core/src/sampling.rs on random uniforms and directions.
+//! GLSL glsl/shading_core/sampling.glsl against crates/shading-core/src/sampling.rs on random uniforms and directions.
 
 use glam::{Vec2, Vec3, Vec4};
 use restir_pt::shading::sampling::*;

@@ -1,6 +1,6 @@
 //! Scenes past one binding's range (maxStorageBufferRange, 128 MiB on lavapipe: about 2.8 M
 //! triangles) reach their triangles, BVH nodes and emitters by buffer device address
-//! (SCENE_ADDRESSED in glsl/scene_bindings.glsl). A lowered `ContextOptions::scene_binding_limit`
+//! (SCENE_ADDRESSED in glsl/interface/scene_bindings.glsl). A lowered `ContextOptions::scene_binding_limit`
 //! sends small scenes down that path, so that whole renders compare it with the bound layout at
 //! test size; scenes really past the limit (triangles; vertex attributes) render too. The
 //! vertex attributes and texels take the same path (`SurfaceGpu`). The oracles of the addressed path are
@@ -72,7 +72,7 @@ fn scale_addressed_layout_renders_the_images_of_the_bound_layout() {
 /// The same with vertex attributes and textures, whose arrays (`SurfaceGpu`) are addressed too:
 /// the normal-mapped box (interpolated normals, tangents, texture coordinates, normal maps),
 /// path traced. ReSTIR PT reads the attributes and texels through the same names of
-/// glsl/surface_bindings.glsl; its four textured kernels, compiled in both layouts, would add
+/// glsl/interface/surface_bindings.glsl; its four textured kernels, compiled in both layouts, would add
 /// minutes of llvmpipe compilation on a cold shader cache.
 #[test]
 fn scale_addressed_surface_attributes_and_texels_render_the_images_of_the_bound_layout() {

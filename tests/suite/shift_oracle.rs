@@ -1,4 +1,4 @@
-//! GLSL glsl/shift.glsl against its Rust twins in crates/shading/src/shift/: the forward shifts
+//! GLSL glsl/shading/shift.glsl against its Rust twins in crates/shading/src/shift/: the forward shifts
 //! (shift_reconnection, shift_random_replay, shift_hybrid) on base paths, and the inverse shifts
 //! (inverse_reconnection, inverse_random_replay, inverse_hybrid) on the paths the Rust forward
 //! shifts made, carried back to the base's primary hit, as the reuse passes' MIS weights use them.
@@ -272,30 +272,36 @@ fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
 
 #[test]
 fn shift_reconnection_glsl_matches_rust() {
+    // GLSL shift_reconnection against its Rust twin.
     check_glsl_matches_rust(Kind::Reconnection, false);
 }
 
 #[test]
 fn shift_random_replay_glsl_matches_rust() {
+    // GLSL shift_random_replay against its Rust twin.
     check_glsl_matches_rust(Kind::RandomReplay, false);
 }
 
 #[test]
 fn shift_hybrid_glsl_matches_rust() {
+    // GLSL shift_hybrid against its Rust twin.
     check_glsl_matches_rust(Kind::Hybrid, false);
 }
 
 #[test]
 fn inverse_reconnection_glsl_matches_rust() {
+    // GLSL inverse_reconnection against its Rust twin.
     check_glsl_matches_rust(Kind::Reconnection, true);
 }
 
 #[test]
 fn inverse_random_replay_glsl_matches_rust() {
+    // GLSL inverse_random_replay against its Rust twin.
     check_glsl_matches_rust(Kind::RandomReplay, true);
 }
 
 #[test]
 fn inverse_hybrid_glsl_matches_rust() {
+    // GLSL inverse_hybrid against its Rust twin.
     check_glsl_matches_rust(Kind::Hybrid, true);
 }

@@ -1,4 +1,4 @@
-//! GLSL surface.glsl, texture.glsl and shading_frame.glsl against crates/shading-core/src/surface.rs, crates/shading-core/src/texture.rs
+//! GLSL glsl/shading_core/surface.glsl, glsl/shading_core/texture.glsl and glsl/scene/hit_surface.glsl against crates/shading-core/src/surface.rs, crates/shading-core/src/texture.rs
 //! and crates/scene/src/hit_surface.rs: surface_at, triangle_bary, texture_lookup, texture_coordinates,
 //! textured_material (with emission_coverage), normal_mapped, texture_tangent_frame (the normal
 //! texture's frame turned and mirrored with its transform), vertex_color, shading_normal and
@@ -155,6 +155,8 @@ fn near_texel_edge(h: &TextureHeader, uv: Vec2) -> bool {
 
 #[test]
 fn surface_at_texture_lookup_textured_material_normal_mapped_glsl_matches_rust() {
+    // GLSL surface_at, triangle_bary, texture_lookup, texture_coordinates, texture_tangent_frame,
+    // textured_material, normal_mapped, shading_normal and hit_shading against their Rust twins (check_item).
     compare_surfaces(&gpu(), &textured_random_scene(7));
 }
 

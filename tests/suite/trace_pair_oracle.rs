@@ -1,4 +1,4 @@
-//! GLSL `trace_pair` (glsl/trace_pair.glsl) against its Rust twin `trace_pair` (crates/shading-core/src/bvh.rs), in
+//! GLSL `trace_pair` (glsl/shading_core/trace_pair.glsl) against its Rust twin `trace_pair` (crates/shading-core/src/bvh.rs), in
 //! both forms: the BVH traversed once for a closest-hit and a shadow ray, and the brute-force
 //! pass of small uniform-buffer scenes; and the twin against `trace_closest`/`trace_occluded`.
 
@@ -121,6 +121,7 @@ fn trace_pair_glsl_matches_rust_bvh_addressed() {
 
 #[test]
 fn trace_pair_glsl_matches_rust_bvh_and_brute_force() {
+    // GLSL trace_pair against its Rust twin (assert_gpu_matches_twin).
     let ctx = gpu();
     let big = random_scene(5);
     let pairs = random_pairs(6, Vec3::ZERO, 6.0);

@@ -55,7 +55,7 @@ glsl_consts! {
 
 gpu_record! {
     struct;
-    /// A material's constant factors, as the kernels read them (glsl/types.glsl `Material`, 64 bytes,
+    /// A material's constant factors, as the kernels read them (glsl/interface/types.glsl `Material`, 64 bytes,
     /// std430); textures scale them per hit (see `restir_pt_shading::texture`). The BSDF built from it is
     /// described in docs/materials.md.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -92,7 +92,7 @@ gpu_record! {
 gpu_record! {
     struct;
     /// A triangle in scene coordinates, stored as vertex 0 and two edges so that the ray-triangle test
-    /// (Möller-Trumbore) needs no subtraction (glsl/types.glsl `Triangle`, 48 bytes, std430). The
+    /// (Möller-Trumbore) needs no subtraction (glsl/interface/types.glsl `Triangle`, 48 bytes, std430). The
     /// counter-clockwise winding v0, v0 + e1, v0 + e2 defines the front face.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct Triangle {
@@ -108,7 +108,7 @@ gpu_record! {
         pub e2: [f32; 3],
         /// 1 if the triangle's material is alpha-tested (`alphaMode` MASK or BLEND), else 0, set by
         /// `restir_pt_scene::Scene::build`: the traversal loops tell alpha-tested hits apart by it
-        /// without loading materials (glsl/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
+        /// without loading materials (glsl/shading_core/alpha_pass.glsl, `restir_pt_shading::alpha_pass`).
         pub alpha_tested: u32,
     }
 }
@@ -116,7 +116,7 @@ gpu_record! {
 gpu_record! {
     struct;
     /// A node of the BVH in depth-first order with skip links, for stackless traversal
-    /// (glsl/types.glsl `BvhNode`, 32 bytes, std430): on a box hit an interior node continues at the
+    /// (glsl/interface/types.glsl `BvhNode`, 32 bytes, std430): on a box hit an interior node continues at the
     /// next node (its left child) and a leaf tests its triangles and continues at `skip`; on a miss
     /// traversal continues at `skip`. A `skip` equal to the node count ends the traversal.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -142,7 +142,7 @@ impl BvhNode {
 
 gpu_record! {
     struct;
-    /// One light that next-event estimation can choose (glsl/types.glsl `Emitter`, 16 bytes, std430):
+    /// One light that next-event estimation can choose (glsl/interface/types.glsl `Emitter`, 16 bytes, std430):
     /// the emissive triangles first (a triangle's [`Triangle::emitter`] is its row), then the point
     /// and spot lights, then the directional lights. The lights before the directional ones are the
     /// leaves of the light tree ([`LightNode`]); each row keeps the path from the tree's root to its
@@ -178,7 +178,7 @@ impl Emitter {
     }
 }
 
-/// Rows of the emitter buffer per punctual light, after the light tree (glsl/types.glsl):
+/// Rows of the emitter buffer per punctual light, after the light tree (glsl/interface/types.glsl):
 /// (position, kind), (direction, cos outer), (intensity, cos inner), (emitter row, 0, 0, 0).
 pub const PUNCTUAL_ROWS: usize = 4;
 
@@ -194,7 +194,7 @@ gpu_record! {
     /// their largest radiant intensities, and the cone of their emission directions: every light
     /// below emits only along directions within θ_o + θ_e of `axis` (θ_o bounds the lights'
     /// normals or spot axes, θ_e the spread about each). Depth-first: an interior node's first child
-    /// follows it, `child` is its second. glsl/light_tree.glsl reads it as [`LIGHT_NODE_ROWS`] rows.
+    /// follows it, `child` is its second. glsl/shading/light_tree.glsl reads it as [`LIGHT_NODE_ROWS`] rows.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct LightNode {
         /// Lower corner of the bounds.
@@ -257,7 +257,7 @@ impl Triangle {
 
 gpu_record! {
     block;
-    /// Binding 0 of every scene kernel (glsl/scene_bindings.glsl), std430 with only vec4-sized rows.
+    /// Binding 0 of every scene kernel (glsl/interface/scene_bindings.glsl), std430 with only vec4-sized rows.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct FrameParams {
         /// xyz: camera position, scene coordinates; w: tan(vertical field of view / 2) for this image
@@ -348,7 +348,7 @@ gpu_record! {
 
 gpu_record! {
     block;
-    /// Binding 5 of the ReSTIR kernels (glsl/restir_bindings.glsl), std430: what every pass
+    /// Binding 5 of the ReSTIR kernels (glsl/interface/restir_bindings.glsl), std430: what every pass
     /// shares, a group per pass that reads it alone (as RTXDI's per-pass parameter structs),
     /// and the frame's pass table.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
@@ -383,7 +383,7 @@ gpu_record! {
 
 gpu_record! {
     struct;
-    /// A pixel's primary hit in one frame (glsl/restir_bindings.glsl).
+    /// A pixel's primary hit in one frame (glsl/interface/restir_bindings.glsl).
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct Surface {
         /// Hit point of the ray through the pixel centre, scene coordinates.
@@ -399,7 +399,7 @@ gpu_record! {
 
 gpu_record! {
     struct;
-    /// The first half of a stored reservoir (glsl/reservoir.glsl).
+    /// The first half of a stored reservoir (glsl/shading_core/reservoir.glsl).
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct ReservoirHead {
         /// `restir_pt_shading::path_record::PathRecord::seed`.
@@ -423,7 +423,7 @@ gpu_record! {
 
 gpu_record! {
     struct;
-    /// The second half of a stored reservoir, with W and M (glsl/reservoir.glsl).
+    /// The second half of a stored reservoir, with W and M (glsl/shading_core/reservoir.glsl).
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct ReservoirTail {
         /// `restir_pt_shading::path_record::PathRecord::suffix`.
@@ -447,10 +447,10 @@ gpu_record! {
 
 gpu_record! {
     block;
-    /// The per-frame counters of the ReSTIR kernels (glsl/restir_bindings.glsl).
+    /// The per-frame counters of the ReSTIR kernels (glsl/interface/restir_bindings.glsl).
     #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
     pub struct RestirStats {
-        /// The most iterations any subgroup's guarded loop ran (glsl/loop_budget.glsl).
+        /// The most iterations any subgroup's guarded loop ran (glsl/interface/loop_budget.glsl).
         pub max_loop_iterations: u32,
         /// Subgroups whose loop hit the iteration budget and was cut short (reported as
         /// `restir_pt_vk::error::GpuError::LoopLimit`).

@@ -1,6 +1,6 @@
 //! The path sample a reservoir stores: everything the shifts need to rebuild or reconnect a path,
 //! and no more (80 bytes). Its GLSL twin is generated (`gpu_record!`); the functions that read
-//! it are twins in `restir_pt_shading_core::path_record` and glsl/path_record.glsl.
+//! it are twins in `restir_pt_shading_core::path_record` and glsl/shading_core/path_record.glsl.
 //!
 //! Random replay needs the seed, the length, the end type and the lobes (to check that the
 //! replayed path has the same vertex types). Reconnection and hybrid also need the reconnection
@@ -16,7 +16,7 @@ glsl_consts! {
     /// The GLSL declarations of this module's constants, for the generated header.
     fn glsl_constants;
     /// Lobe bits of a sampled direction (`restir_pt_shading_core::bsdf::BsdfSample::lobe`, [`PathRecord::lobes`]); shared with
-    /// glsl/bsdf.glsl. No lobe: a failed sample, or a vertex whose successor NEE chose.
+    /// glsl/shading_core/bsdf.glsl. No lobe: a failed sample, or a vertex whose successor NEE chose.
     pub const LOBE_NONE: u32 = 0;
     /// The Lambertian base of the non-metal part.
     pub const LOBE_DIFFUSE: u32 = 1;
@@ -44,7 +44,7 @@ glsl_consts! {
 
 gpu_record! {
     struct;
-    /// A reservoir's path sample (glsl/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
+    /// A reservoir's path sample (glsl/shading_core/path_record.glsl `PathRecord`, 80 bytes, std430; stored on the
     /// GPU split into [`crate::gpu_types::ReservoirHead`] and [`crate::gpu_types::ReservoirTail`]).
     /// x_0 is the camera, x_1..x_k the path's vertices, x_r the reconnection vertex; positions and
     /// directions are in scene coordinates, colours linear RGB.

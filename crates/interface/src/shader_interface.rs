@@ -74,7 +74,7 @@ macro_rules! binding_family {
 }
 
 binding_family! {
-    /// Bindings 0-4 of every scene kernel (glsl/scene_bindings.glsl): the frame parameters and
+    /// Bindings 0-4 of every scene kernel (glsl/interface/scene_bindings.glsl): the frame parameters and
     /// the scene arrays. The scene arrays are storage or uniform buffers (`SceneGpu::uniform`).
     SceneBinding, "SCENE_BINDING_", set 0 {
         /// `gpu_types::FrameParams`, a host-written storage buffer.
@@ -104,7 +104,7 @@ binding_family! {
 }
 
 binding_family! {
-    /// Bindings 5-18 of the ReSTIR PT kernels (glsl/restir_bindings.glsl), storage buffers.
+    /// Bindings 5-18 of the ReSTIR PT kernels (glsl/interface/restir_bindings.glsl), storage buffers.
     /// Surfaces alternate between frames; reservoir slots rotate within and between frames
     /// (src/render/frame_plan.rs), each slot a head and a tail buffer.
     RestirBinding, "RESTIR_BINDING_", set 0 {
@@ -141,7 +141,7 @@ binding_family! {
 
 binding_family! {
     /// Descriptor set 1 of scene kernels whose scene has surface attributes or textures
-    /// (glsl/surface_bindings.glsl, src/render/surface_gpu.rs), storage buffers. Set 0 keeps
+    /// (glsl/interface/surface_bindings.glsl, src/render/surface_gpu.rs), storage buffers. Set 0 keeps
     /// what traversal reads; these are read only at hits. Oracle kernels that bind everything
     /// in set 0 move the family there (`SURFACE_SET`, `SURFACE_BINDING` in the GLSL).
     SurfaceBinding, "SURFACE_BINDING_", set 1 {
@@ -280,12 +280,12 @@ pub const MAX_INPUTS: u32 = MAX_NEIGHBOURS + 1;
 pub const IMAGE_LOCAL_SIZE: u32 = 8;
 /// Russian roulette starts at path vertex x_3 (x_1 the primary hit): the path tracer decides
 /// there, after its NEE, whether to trace on; ReSTIR PT's initial candidates decide before
-/// their NEE at x_3 (glsl/restir_candidates.glsl). The first two bounces always continue.
+/// their NEE at x_3 (glsl/shading/candidates.glsl). The first two bounces always continue.
 pub const RR_START_DEPTH: u32 = 3;
 /// Russian roulette's survival probability is the path throughput's largest channel, at most
 /// this, so that paths of throughput near 1 (closed scenes of albedo near 1) still end.
 pub const RR_MAX_SURVIVAL: f32 = 0.95;
-/// Profile counters of glsl/counters.glsl, in its order (COUNTER_TRAVERSALS ...
+/// Profile counters of glsl/interface/counters.glsl, in its order (COUNTER_TRAVERSALS ...
 /// COUNTER_STEP_ITERATIONS), each a 64-bit sum.
 pub const COUNTER_COUNT: usize = 7;
 
@@ -306,7 +306,7 @@ glsl_consts! {
     /// ReSTIR's choice of directional light k's NEE candidate at a vertex: stream
     /// `STREAM_DIRECTIONAL + k` (x).
     pub const STREAM_DIRECTIONAL: u32 = 4;
-    /// Profile counter (glsl/counters.glsl): traversals a lane started (one ray or one pair).
+    /// Profile counter (glsl/interface/counters.glsl): traversals a lane started (one ray or one pair).
     pub const COUNTER_TRAVERSALS: u32 = 0;
     /// Profile counter: BVH nodes a lane visited.
     pub const COUNTER_NODE_VISITS: u32 = 1;
@@ -320,7 +320,7 @@ glsl_consts! {
     pub const COUNTER_TRIANGLE_ITERATIONS: u32 = 5;
     /// Profile counter: path-step iterations of a subgroup.
     pub const COUNTER_STEP_ITERATIONS: u32 = 6;
-    /// Interpolated vectors shorter than this (squared) count as missing (glsl/surface.glsl,
+    /// Interpolated vectors shorter than this (squared) count as missing (glsl/shading_core/surface.glsl,
     /// `restir_pt_shading_core::surface`).
     pub const SURFACE_MIN_LENGTH_SQUARED: f32 = 1e-12;
     /// Below this alpha (roughness ~0.032) a lobe is a perfect (delta) specular: narrower GGX lobes

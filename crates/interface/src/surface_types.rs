@@ -1,6 +1,6 @@
 //! The records of descriptor set 1 (`SurfaceBinding`): per-triangle vertex attributes and the
 //! material textures, with the constants of their encodings. The functions that read them are
-//! twins in `restir_pt_shading_core::surface` and `::texture` (glsl/surface.glsl, texture.glsl).
+//! twins in `restir_pt_shading_core::surface` and `::texture` (glsl/shading_core/surface.glsl, texture.glsl).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -31,7 +31,7 @@ glsl_consts! {
 gpu_record! {
     struct;
     /// The attributes of one triangle's three vertices (v0, v0 + e1, v0 + e2), in scene space
-    /// (the triangles' coordinates), std430 layout of `TriangleSurface` in glsl/surface.glsl.
+    /// (the triangles' coordinates), std430 layout of `TriangleSurface` in glsl/shading_core/surface.glsl.
     #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
     pub struct TriangleSurface {
         /// xyz: the vertex normal (unit, or zero where the file gave none or the triangle is flat:
@@ -55,7 +55,7 @@ impl TriangleSurface {
 
 gpu_record! {
     struct;
-    /// A texture's place in `SceneTextures::texels` (`restir_pt_shading_core::texture`) and its sampler (glsl/surface_bindings.glsl).
+    /// A texture's place in `SceneTextures::texels` (`restir_pt_shading_core::texture`) and its sampler (glsl/interface/surface_bindings.glsl).
     #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
     pub struct TextureHeader {
         /// Width in texels.

@@ -1,5 +1,5 @@
 //! Binned-SAH BVH built on the CPU and flattened depth-first with skip links; its traversal twin
-//! of glsl/bvh.glsl is `restir_pt_shading_core::bvh`.
+//! of glsl/shading_core/bvh.glsl is `restir_pt_shading_core::bvh`.
 
 use glam::Vec3;
 

@@ -143,7 +143,7 @@ impl Camera {
         params.cam_forward = self.forward.extend(0.0).into();
     }
 
-    /// Twin of GLSL `camera_ray_dir` (glsl/camera.glsl): direction through image point (px, py),
+    /// Twin of GLSL `camera_ray_dir` (glsl/scene/camera.glsl): direction through image point (px, py),
     /// in pixels from the top-left corner.
     pub fn ray_dir(&self, px: f32, py: f32, width: u32, height: u32) -> Vec3 {
         let tan_half = self.tan_half_fov(width, height);

@@ -1,7 +1,7 @@
 //! Equirectangular environment maps (`--env FILE.exr|FILE.hdr`), importance-sampled by luminance:
 //! a texel is chosen with probability proportional to its luminance times sin θ (its solid
 //! angle), then a direction uniformly in its (u, v) rectangle (pbrt-v4's piecewise-constant 2D
-//! distribution, "Sampling Light Sources"). Twin of the environment half of glsl/lights.glsl.
+//! distribution, "Sampling Light Sources"). Twin of the environment half of glsl/shading/lights.glsl.
 //!
 //! Mapping (Mitsuba 3's `envmap` with an identity `to_world`): in the map's own frame
 //! u = atan2(d.x, -d.z) / 2π wrapped to [0, 1) across the image, so its left and right edges look
@@ -215,7 +215,7 @@ impl EnvironmentMap {
         env_rotate(local, self.rotation)
     }
 
-    /// The rows after the punctual lights in the emitter buffer (glsl/types.glsl): a header
+    /// The rows after the punctual lights in the emitter buffer (glsl/interface/types.glsl): a header
     /// (width, cos, sin, height) with the rotation's cosine and sine, the row CDF (one per row),
     /// then per texel (r, g, b, row CDF value).
     pub fn gpu_rows(&self) -> Vec<Emitter> {

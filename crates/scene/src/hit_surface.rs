@@ -1,6 +1,6 @@
 //! What a hit on the scene sees: its surface (crates/shading-core/src/surface.rs) and its material with textures
 //! applied (crates/shading-core/src/texture.rs). Host counterparts of `surface_at`, `material_at` and
-//! `normal_mapped` in glsl/surface.glsl and glsl/texture.glsl.
+//! `normal_mapped` in glsl/shading_core/surface.glsl and glsl/shading_core/texture.glsl.
 
 use glam::{Vec2, Vec3};
 
@@ -47,7 +47,7 @@ impl Scene {
 
     /// The shading normal of triangle `triangle` at `bary` (unit, scene space, not flipped): the
     /// interpolated vertex normal with its material's normal map applied; the geometric normal
-    /// as wound where there are neither. Twin of GLSL `shading_normal` (glsl/shading_frame.glsl).
+    /// as wound where there are neither. Twin of GLSL `shading_normal` (glsl/scene/hit_surface.glsl).
     pub fn shading_normal(&self, triangle: u32, bary: Vec2) -> Vec3 {
         let s = self.surface_at(triangle, bary);
         if self.textures.is_empty() || self.surfaces.is_empty() {
@@ -59,7 +59,7 @@ impl Scene {
 
     /// The material (textures applied) and the shading normal of triangle `triangle` at `bary`,
     /// from one surface: what the path tracer hands the BSDF with the geometric normal. Twin of
-    /// GLSL `hit_shading` (glsl/shading_frame.glsl).
+    /// GLSL `hit_shading` (glsl/scene/hit_surface.glsl).
     pub fn hit_shading(&self, triangle: u32, bary: Vec2) -> (Material, Vec3) {
         let index = self.triangles[triangle as usize].material as usize;
         let m = &self.materials[index];

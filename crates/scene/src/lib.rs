@@ -283,7 +283,7 @@ impl Scene {
         punctual::punctual_rows(&self.lights, &self.punctual_emitter_rows)
     }
 
-    /// The emitter-buffer rows of the light tree (glsl/light_tree.glsl): a header (directional
+    /// The emitter-buffer rows of the light tree (glsl/shading/light_tree.glsl): a header (directional
     /// lights, nodes, 0, 0), then [`restir_pt_interface::gpu_types::LIGHT_NODE_ROWS`] rows per node.
     pub fn light_tree_rows(&self) -> Vec<Emitter> {
         let header = Emitter::from_words([self.directional_count, self.light_nodes.len() as u32, 0, 0]);

@@ -2,7 +2,7 @@
 //! lights that next-event estimation descends to choose a light by its likely contribution at the
 //! shading point rather than by its power alone (pbrt-v4 `BVHLightSampler`; Conty Estevez and
 //! Kulla, "Importance Sampling of Many Lights with Adaptive Tree Splitting", 2018). Built here on
-//! the host, flattened depth first into [`LightNode`]s; glsl/light_tree.glsl and its twin
+//! the host, flattened depth first into [`LightNode`]s; glsl/shading/light_tree.glsl and its twin
 //! crates/shading/src/light_tree.rs walk it.
 
 use glam::{Quat, Vec3};

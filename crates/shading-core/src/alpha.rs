@@ -1,4 +1,4 @@
-//! Alpha testing inside traversal, the twin of glsl/alpha.glsl: glTF `alphaMode` MASK (a hit
+//! Alpha testing inside traversal, the twin of glsl/shading_core/alpha.glsl: glTF `alphaMode` MASK (a hit
 //! whose alpha is below `alphaCutoff` is no hit) and BLEND as stochastic transparency (a hit is
 //! kept with probability alpha). `alpha_hash` and `alpha_keeps` have GLSL functions of the same
 //! names, compared in tests/suite/alpha_oracle.rs (docs/materials.md, "Alpha modes").

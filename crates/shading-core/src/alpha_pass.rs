@@ -1,4 +1,4 @@
-//! Alpha tests out of the triangle loops, the twin of glsl/alpha_pass.glsl: a traversal pass
+//! Alpha tests out of the triangle loops, the twin of glsl/shading_core/alpha_pass.glsl: a traversal pass
 //! records, per ray, the nearest hit on a triangle without alpha testing and the nearest
 //! alpha-tested hit before it, and `alpha_keeps` runs once after the loop (llvmpipe would run a
 //! test inside the loop under a mask on every iteration). A rejected hit sends the ray through

@@ -1,5 +1,5 @@
-//! Traversal of scenes with alpha-tested materials, the twins of glsl/alpha_trace.glsl
-//! (`bvh_traverse`, `bvh_alpha_pass`) and glsl/alpha_trace_pair.glsl (`trace_pair`,
+//! Traversal of scenes with alpha-tested materials, the twins of glsl/shading_core/alpha_trace.glsl
+//! (`bvh_traverse`, `bvh_alpha_pass`) and glsl/shading_core/alpha_trace_pair.glsl (`trace_pair`,
 //! `trace_pair_alpha_pass`): the loops record candidate hits and the alpha tests run after them
 //! ([`crate::alpha_pass`]). [`crate::bvh::bvh_traverse`] and
 //! [`crate::bvh::trace_pair`] call these when given an [`AlphaScene`].

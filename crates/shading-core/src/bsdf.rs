@@ -1,4 +1,4 @@
-//! The material model, twin of glsl/bsdf.glsl: a linear blend of a Lambertian lobe under a GGX
+//! The material model, twin of glsl/shading_core/bsdf.glsl: a linear blend of a Lambertian lobe under a GGX
 //! specular layer (the glTF non-metal), a GGX conductor and a GGX (or smooth) dielectric
 //! (docs/materials.md). Directions point away from the surface.
 
@@ -16,7 +16,7 @@ pub fn index_matched(eta: f32) -> bool {
     (eta - 1.0).abs() <= INDEX_MATCHED_TOLERANCE
 }
 
-/// A direction sampled from the BSDF (twin of GLSL `BsdfSample`, glsl/bsdf.glsl). A failed
+/// A direction sampled from the BSDF (twin of GLSL `BsdfSample`, glsl/shading_core/bsdf.glsl). A failed
 /// sample has zero `weight`, zero `pdf` and [`LOBE_NONE`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSample {

@@ -1,4 +1,4 @@
-//! The stackless BVH traversal twin of glsl/bvh.glsl, the oracle for GPU hits, over the
+//! The stackless BVH traversal twin of glsl/shading_core/bvh.glsl, the oracle for GPU hits, over the
 //! depth-first nodes with skip links that `restir_pt_scene::bvh` builds.
 
 use glam::{Vec2, Vec3};
@@ -10,7 +10,7 @@ use crate::ray_offset::offset_ray_origin;
 
 pub use restir_pt_interface::gpu_types::NO_HIT;
 
-/// A ray's hit (twin of GLSL `Hit`, glsl/bvh.glsl).
+/// A ray's hit (twin of GLSL `Hit`, glsl/shading_core/bvh.glsl).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit: distance along the ray in units of |d| (scene units for a unit d).
@@ -125,7 +125,7 @@ pub use restir_pt_interface::shader_interface::SEGMENT_EPSILON;
 
 /// Whether anything blocks the segment between surface points p (normal np, on triangle index
 /// tp) and q (normal nq, on triangle index tq): the ray of `segment_ray`, traced (the kernels
-/// trace it inside `visibility_ray` of glsl/shift_vertex.glsl). Both ends are offset off their
+/// trace it inside `visibility_ray` of glsl/shading/shift/vertex.glsl). Both ends are offset off their
 /// surfaces, each towards the other: offsetting one end only moves a grazing far hit by more
 /// than any epsilon.
 #[allow(clippy::too_many_arguments)]
@@ -150,7 +150,7 @@ pub struct PairRay {
 /// loops cost more than the triangle tests they save (docs/performance.md).
 pub const BRUTE_FORCE_MAX_TRIANGLES: usize = 64;
 
-/// Twin of GLSL `trace_pair` (glsl/trace_pair.glsl): the closest hit of `closest` and whether
+/// Twin of GLSL `trace_pair` (glsl/shading_core/trace_pair.glsl): the closest hit of `closest` and whether
 /// anything blocks `shadow`, in one traversal of the BVH (or, with `brute_force`, one pass over
 /// every triangle in index order, the closest hit being the first of equal distances). The BVH
 /// form tests each ray against the same triangles in the same order as `bvh_traverse`, so its

@@ -131,7 +131,7 @@ pub fn resampled_expectation<S: Copy>(domains: &impl Domains<S>, inputs: &[Input
 
 /// The target function p̂ of a path: the luminance of its contribution f (RGB). Every channel
 /// has a positive weight, so p̂ > 0 wherever f is non-zero, as unbiased resampling requires.
-/// Twin of `target_function` in glsl/reservoir.glsl.
+/// Twin of `target_function` in glsl/shading_core/reservoir.glsl.
 pub fn target_function(contribution: Vec3) -> f32 {
     contribution.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
@@ -141,7 +141,7 @@ pub fn target_function(contribution: Vec3) -> f32 {
 /// w_i / sum_j w_j, and `resampler_finish` gives W = sum_j w_j / p̂(chosen). `expected` is
 /// sum_i w_i f(y_i) / p̂(y_i), the expectation of f(Y) W_Y over the choice (see
 /// `resampled_expectation`), in RGB. Single precision, as on the GPU. Twin: `Resampler` and
-/// its functions in glsl/reservoir.glsl.
+/// its functions in glsl/shading_core/reservoir.glsl.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Resampler<S> {
     /// The chosen candidate so far; `None` before the first is chosen.

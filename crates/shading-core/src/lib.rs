@@ -1,7 +1,7 @@
 //! restir-pt-shading-core: the Rust twins of the GLSL functions that read only host–shader
 //! records (triangles, BVH nodes, materials, surfaces, textures, path records), not a whole
 //! scene. Each function an oracle test pairs with a GLSL function has the same name as it, in
-//! the module named for the GLSL include (`bsdf` for glsl/bsdf.glsl, `bvh` for glsl/bvh.glsl,
+//! the module named for the GLSL include (`bsdf` for glsl/shading_core/bsdf.glsl, `bvh` for glsl/shading_core/bvh.glsl,
 //! ...); `gris` holds the reuse estimator the ReSTIR passes implement.
 //!
 //! It may use restir-pt-interface (the records) and nothing else of the workspace. It sits below

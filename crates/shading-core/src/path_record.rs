@@ -1,5 +1,5 @@
 //! The functions that read a reservoir's path sample ([`PathRecord`], a record of the interface
-//! crate): twins of glsl/path_record.glsl.
+//! crate): twins of glsl/shading_core/path_record.glsl.
 
 pub use restir_pt_interface::path_record::{PathRecord, INFO_DIRECTIONAL_SHIFT, INFO_LENGTH_MASK, INFO_NEE_END, INFO_RC_SHIFT, LOBE_BITS};
 pub use restir_pt_interface::shader_interface::MAX_PATH_LENGTH;

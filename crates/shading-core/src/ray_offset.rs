@@ -1,4 +1,4 @@
-//! Error-bounded ray origins, twin of glsl/ray_offset.glsl: every ray that leaves a surface (path
+//! Error-bounded ray origins, twin of glsl/shading_core/ray_offset.glsl: every ray that leaves a surface (path
 //! continuation, shadow ray, NEE, shift visibility) starts at [`offset_ray_origin`].
 //!
 //! A surface point is computed as `p = v0 + b1 e1 + b2 e2` in f32. Its rounding error is at most

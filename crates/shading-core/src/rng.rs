@@ -1,4 +1,4 @@
-//! Counter-based RNG, the bit-exact twin of glsl/rng.glsl.
+//! Counter-based RNG, the bit-exact twin of glsl/shading_core/rng.glsl.
 
 use glam::{UVec4, Vec4};
 

@@ -1,4 +1,4 @@
-//! Warping uniforms to directions and points; the twin of glsl/sampling.glsl.
+//! Warping uniforms to directions and points; the twin of glsl/shading_core/sampling.glsl.
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;

@@ -1,5 +1,5 @@
 //! Per-triangle surface attributes (vertex normals, tangents, texture coordinates) and the
-//! surface of a hit built from them. Twin of glsl/surface.glsl: `surface_at` has a GLSL function
+//! surface of a hit built from them. Twin of glsl/shading_core/surface.glsl: `surface_at` has a GLSL function
 //! of the same name, compared in tests/suite/surface_oracle.rs.
 //!
 //! The attributes live in their own array, parallel to the triangles (same BVH order) and read

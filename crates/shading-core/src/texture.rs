@@ -1,6 +1,6 @@
 //! Material textures: texels in one storage buffer with the lookup (address modes, bilinear or
 //! nearest filtering, sRGB decoding) done by hand, and the material a hit sees once its textures
-//! apply. Twin of glsl/texture.glsl: `texture_lookup`, `texture_coordinates`,
+//! apply. Twin of glsl/shading_core/texture.glsl: `texture_lookup`, `texture_coordinates`,
 //! `textured_material` and `normal_mapped` have GLSL functions of the same names, compared in
 //! tests/suite/surface_oracle.rs. Why a buffer rather than sampled images: docs/textures.md.
 

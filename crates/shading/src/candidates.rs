@@ -2,7 +2,7 @@
 //! ends on a light, by NEE at a vertex (the drawn light and every directional light, each a
 //! technique of its own) or by a BSDF-sampled hit, each weighted by the balance
 //! heuristic of its end technique (`end_mis_weight`), to a streaming `Resampler`. Twin of
-//! glsl/restir_candidates.glsl, which the initial pass runs; docs/restir.md describes the pass.
+//! glsl/shading/candidates.glsl, which the initial pass runs; docs/restir.md describes the pass.
 
 use glam::Vec3;
 

@@ -1,6 +1,6 @@
 //! restir-pt-shading, the shading twins: the Rust oracles of the GLSL functions the kernels run.
 //! Each function an oracle test pairs with a GLSL function has the same name as it, in the
-//! module named for the GLSL include (`bsdf` for glsl/bsdf.glsl, `shift` for glsl/shift.glsl,
+//! module named for the GLSL include (`bsdf` for glsl/shading_core/bsdf.glsl, `shift` for glsl/shading/shift.glsl,
 //! ...), and `gris` holds the reuse estimator the ReSTIR passes implement (`resample_inputs`
 //! their loop, step for step).
 //!

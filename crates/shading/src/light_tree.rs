@@ -1,6 +1,6 @@
 //! Light selection by likely contribution at the shading point: the descent of the light tree
 //! (crates/scene/src/light_tree.rs builds it) and the probability of its choice. Twin of
-//! glsl/light_tree.glsl; each function is named as in GLSL.
+//! glsl/shading/light_tree.glsl; each function is named as in GLSL.
 
 use glam::Vec3;
 

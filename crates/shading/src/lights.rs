@@ -1,4 +1,4 @@
-//! Next-event estimation: the twin of glsl/lights.glsl. Lights are chosen by their likely
+//! Next-event estimation: the twin of glsl/shading/lights.glsl. Lights are chosen by their likely
 //! contribution at the shading point (the light tree, crates/shading/src/light_tree.rs); point and spot
 //! lights (KHR_lights_punctual) are chosen beside emissive triangles, and directional lights are
 //! not chosen but taken at every vertex ([`sample_directional`]). A sample of a punctual light
@@ -14,7 +14,7 @@ use crate::light_tree::{directional_row, light_select, light_select_pmf};
 use crate::sampling::{sample_triangle, sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 
 /// A next-event-estimation sample from a shading point (twin of GLSL `LightSample`,
-/// glsl/lights.glsl). A failed sample has zero `pdf` and `radiance`.
+/// glsl/shading/lights.glsl). A failed sample has zero `pdf` and `radiance`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightSample {
     /// Unit direction from the shading point towards the light, world space.
@@ -69,7 +69,7 @@ pub fn punctual_arrival(light: &PunctualLight, p: Vec3) -> (Vec3, f32, Vec3) {
 
 /// Whether anything blocks the way from surface point `x` (normal `n`, on triangle index `tri`)
 /// to a punctual light along the unit `dir` at distance `dist` (infinite: a directional light);
-/// only x is offset, the light being a point in the air. Twin of GLSL `punctual_occluded` (glsl/punctual.glsl).
+/// only x is offset, the light being a point in the air. Twin of GLSL `punctual_occluded` (glsl/shading/punctual.glsl).
 pub fn punctual_occluded(scene: &Scene, x: Vec3, n: Vec3, tri: u32, dir: Vec3, dist: f32) -> bool {
     use restir_pt_shading_core::bvh::{trace_occluded, SEGMENT_EPSILON};
     let origin = crate::ray_offset::offset_ray_origin(x, if dir.dot(n) > 0.0 { n } else { -n }, &scene.triangles[tri as usize]);

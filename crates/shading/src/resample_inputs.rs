@@ -1,4 +1,4 @@
-//! The reuse loop of GRIS, twin of glsl/resample_inputs.glsl: inputs from other domains are
+//! The reuse loop of GRIS, twin of glsl/shading/resample_inputs.glsl: inputs from other domains are
 //! shifted into the canonical domain, weighted by w_i = m_i(y_i) p̂(y_i) W_{X_i} |T_i'(X_i)|
 //! with MIS weights from inverse shifts (docs/restir.md), and one is chosen by the streaming
 //! resampler ([`crate::gris::Resampler`]). Single precision and step for step as the
@@ -13,7 +13,7 @@ use crate::rng::{rng_uniform4, STREAM_RESAMPLE};
 use crate::shift::ShiftResult;
 
 /// A reservoir: a path sample with its unbiased contribution weight W and confidence M. Twin of
-/// GLSL `Reservoir` (glsl/reservoir.glsl).
+/// GLSL `Reservoir` (glsl/shading_core/reservoir.glsl).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reservoir {
     /// The sample Y.
@@ -25,7 +25,7 @@ pub struct Reservoir {
 }
 
 /// What the reuse loop needs from the domains and shifts, the twin of the functions a kernel
-/// defines before it includes glsl/resample_inputs.glsl (`input_reservoir`, `input_domain`,
+/// defines before it includes glsl/shading/resample_inputs.glsl (`input_reservoir`, `input_domain`,
 /// `same_domain`, `shift_path`), as RTXDI's resampling runs on its `RAB_*` bridge.
 pub trait ReuseBridge {
     /// Where a sample lives: for ReSTIR PT a pixel seen from one frame's camera.
@@ -41,7 +41,7 @@ pub trait ReuseBridge {
     fn shift_path(&mut self, record: &PathRecord, to: Self::Domain) -> ShiftResult;
 }
 
-/// Counts of the loop, as the kernels' counters take them (glsl/restir_bindings.glsl).
+/// Counts of the loop, as the kernels' counters take them (glsl/interface/restir_bindings.glsl).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ReuseCounters {
     /// Shifts that failed, and resampling weights that came out non-finite for an input of
@@ -53,7 +53,7 @@ pub struct ReuseCounters {
 
 /// Whether input `i`'s MIS weight needs p̂_{<-l} of its shifted sample for l >= 1, l != i: for
 /// every l under the generalized balance heuristic, only for the canonical input under pairwise
-/// MIS. Twin of GLSL `needs_targets_from` (glsl/gris.glsl).
+/// MIS. Twin of GLSL `needs_targets_from` (glsl/shading_core/gris.glsl).
 pub fn needs_targets_from(mis: Mis, i: usize) -> bool {
     match mis {
         Mis::Pairwise => i == 0,

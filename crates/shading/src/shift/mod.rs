@@ -1,7 +1,7 @@
 //! Shift mappings of ReSTIR PT in the primary-sample-space (PSS) measure: the Rust reference that
-//! glsl/shift.glsl is to mirror, file by file: `vertex.rs` (glsl/shift_vertex.glsl), `path.rs`
-//! (shift_path.glsl), `reconnection.rs` (shift_reconnection.glsl) and the shifts here
-//! (shift.glsl). A path is regenerated from its primary hit and its seed (the counter-based RNG
+//! glsl/shading/shift.glsl is to mirror, file by file: `vertex.rs` (glsl/shading/shift/vertex.glsl), `path.rs`
+//! (glsl/shading/shift/path.glsl), `reconnection.rs` (glsl/shading/shift/reconnection.glsl) and the shifts here
+//! (glsl/shading/shift.glsl). A path is regenerated from its primary hit and its seed (the counter-based RNG
 //! of crates/shading-core/src/rng.rs), so random replay needs nothing else; reconnection and hybrid keep the
 //! base path's suffix from the reconnection vertex x_r on.
 //!

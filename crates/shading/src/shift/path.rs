@@ -1,6 +1,6 @@
 //! Paths regenerated in primary sample space from a primary hit and a seed (random replay's map,
 //! and the replayed prefix of the hybrid shift), and the result every shift returns. Twin of
-//! glsl/shift_path.glsl.
+//! glsl/shading/shift/path.glsl.
 
 use glam::Vec3;
 

@@ -1,6 +1,6 @@
 //! The reconnection of a predecessor to a record's x_r: the edge's BSDF, pdf and geometry term,
 //! the BSDF at x_r towards x_{r+1}, the Jacobian of the shift that makes it, and the path record
-//! that caches the base side's terms. Twin of glsl/shift_reconnection.glsl.
+//! that caches the base side's terms. Twin of glsl/shading/shift/reconnection.glsl.
 
 use glam::Vec3;
 

@@ -1,6 +1,6 @@
 //! The vertices of ReSTIR PT's paths and what the shifts evaluate between two of them: the
 //! reconnection test, visibility, the emission and light pdf at the end, and the end's MIS
-//! weight. Twin of glsl/shift_vertex.glsl.
+//! weight. Twin of glsl/shading/shift/vertex.glsl.
 
 use glam::Vec3;
 
@@ -26,7 +26,7 @@ pub const DEFAULT_DISTANCE_FRACTION: f32 = 0.03;
 
 /// The reconnection criteria of the shifts (Lin et al. 2022: a vertex is reconnectable when it
 /// and its predecessor are rough and far enough apart). Twin of GLSL `ShiftParams`
-/// (glsl/shift_vertex.glsl); the kernels read it from [`restir_pt_interface::gpu_types::ReuseParams`].
+/// (glsl/shading/shift/vertex.glsl); the kernels read it from [`restir_pt_interface::gpu_types::ReuseParams`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShiftParams {
     /// Perceptual roughness below which a GGX lobe counts as glossy: such a vertex cannot be a

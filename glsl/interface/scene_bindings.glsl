@@ -4,7 +4,7 @@
 #ifndef SCENE_BINDINGS_GLSL
 #define SCENE_BINDINGS_GLSL
 
-#include "types.glsl"
+#include "interface/types.glsl"
 
 // A read-only storage buffer, not a uniform buffer: lavapipe compiles a kernel again for every
 // new value of a uniform or push constant that steers its control flow (crates/vk/src/buffer.rs).

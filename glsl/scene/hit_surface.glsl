@@ -1,6 +1,6 @@
 // The shading frame at a hit: the material with its textures and the shading normal (the
 // interpolated vertex normal, then the material's normal map with its scale), both from one
-// surface_at. BSDFs take it with the geometric normal (bsdf.glsl, docs/materials.md "Shading
+// surface_at. BSDFs take it with the geometric normal (shading_core/bsdf.glsl, docs/materials.md "Shading
 // normals"); measure conversions and ray offsets keep the geometric normal.
 // Kernels of a scene without vertex normals and normal maps (SCENE_SHADING_NORMALS 0, set by
 // src/render/scene_gpu.rs) compile none of it and shade with the geometric normal.
@@ -8,7 +8,7 @@
 #ifndef SHADING_FRAME_GLSL
 #define SHADING_FRAME_GLSL
 
-#include "texture.glsl"
+#include "shading_core/texture.glsl"
 
 #ifndef SCENE_SHADING_NORMALS
 #define SCENE_SHADING_NORMALS 0

@@ -7,8 +7,8 @@
 #ifndef ALPHA_GLSL
 #define ALPHA_GLSL
 
-#include "rng.glsl"
-#include "texture.glsl"
+#include "shading_core/rng.glsl"
+#include "shading_core/texture.glsl"
 
 // BLEND's uniform number for triangle index `triangle` met by the ray (o, d): a hash of the
 // ray's bits and the triangle rather than a draw from the path's sample stream, so that tracing

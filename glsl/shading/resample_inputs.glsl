@@ -1,6 +1,6 @@
 // The reuse loop of GRIS (docs/restir.md): inputs from other domains are shifted into the
-// canonical domain, weighted by resampling MIS weights (gris.glsl) computed with inverse shifts,
-// and one is chosen by the streaming resampler (reservoir.glsl). Twin: resample_inputs in
+// canonical domain, weighted by resampling MIS weights (shading_core/gris.glsl) computed with inverse shifts,
+// and one is chosen by the streaming resampler (shading_core/reservoir.glsl). Twin: resample_inputs in
 // crates/shading/src/resample_inputs.rs, whose test runs both on the toy domains of the GRIS tests.
 //
 // It runs on a bridge the including file defines first, as RTXDI's resampling functions run on
@@ -16,13 +16,13 @@
 #ifndef RESAMPLE_INPUTS_GLSL
 #define RESAMPLE_INPUTS_GLSL
 
-#include "gris.glsl"
-#include "reservoir.glsl"
-#include "rng.glsl"
-#include "shift_result.glsl"
+#include "shading_core/gris.glsl"
+#include "shading_core/reservoir.glsl"
+#include "shading_core/rng.glsl"
+#include "shading/shift/result.glsl"
 
 // Resamples inputs 0..n-1 (0: the canonical pixel's own reservoir), whose confidence weights
-// c_l the caller has put in `confidences` (gris.glsl), into one reservoir of the canonical
+// c_l the caller has put in `confidences` (shading_core/gris.glsl), into one reservoir of the canonical
 // domain; `seed` keys the choice. `expected` receives E[f(Y) W_Y] over the choice.
 //
 // Step (i, l) of the n x n steps makes at most one shift: for l = 0 the shift of input i's

@@ -1,10 +1,10 @@
-// bvh_traverse for scenes with alpha-tested materials (SCENE_ALPHA), included by bvh.glsl: the
-// loop records candidate hits and the alpha tests run after it (alpha_pass.glsl). Twin:
+// bvh_traverse for scenes with alpha-tested materials (SCENE_ALPHA), included by shading_core/bvh.glsl: the
+// loop records candidate hits and the alpha tests run after it (shading_core/alpha_pass.glsl). Twin:
 // bvh_traverse and bvh_alpha_pass in crates/shading-core/src/alpha_trace.rs.
 #ifndef ALPHA_TRACE_GLSL
 #define ALPHA_TRACE_GLSL
 
-#include "alpha_pass.glsl"
+#include "shading_core/alpha_pass.glsl"
 
 // One pass of the ray (o, d) over the BVH: boxes are culled at the nearest opaque hit so far, so
 // that every alpha-tested hit before it is met; with any_hit the pass ends at an opaque hit.

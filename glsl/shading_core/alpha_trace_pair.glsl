@@ -1,11 +1,11 @@
-// trace_pair for scenes with alpha-tested materials (SCENE_ALPHA), included by trace_pair.glsl:
+// trace_pair for scenes with alpha-tested materials (SCENE_ALPHA), included by shading_core/trace_pair.glsl:
 // each pass traverses for both rays still open, recording candidate hits, and the alpha tests
-// run after it (alpha_pass.glsl). Twin: trace_pair and trace_pair_alpha_pass in
+// run after it (shading_core/alpha_pass.glsl). Twin: trace_pair and trace_pair_alpha_pass in
 // crates/shading-core/src/alpha_trace.rs.
 #ifndef ALPHA_TRACE_PAIR_GLSL
 #define ALPHA_TRACE_PAIR_GLSL
 
-#include "alpha_pass.glsl"
+#include "shading_core/alpha_pass.glsl"
 
 // Tests triangle index i for the closest ray (if enter_c) and the shadow ray (if enter_s).
 void alpha_pair_test(uint i, PairRay closest, PairRay shadow, bool enter_c, bool enter_s, inout AlphaPass c, inout AlphaPass s) {

@@ -1,12 +1,12 @@
 // Shift mappings of ReSTIR PT in primary sample space: random replay, reconnection and hybrid,
-// with their inverses, on path records. Built from path vertices (shift_vertex.glsl), regenerated
-// paths (shift_path.glsl) and the reconnection with its Jacobian (shift_reconnection.glsl).
+// with their inverses, on path records. Built from path vertices (shading/shift/vertex.glsl), regenerated
+// paths (shading/shift/path.glsl) and the reconnection with its Jacobian (shading/shift/reconnection.glsl).
 // Expects the scene bindings. Twin: crates/shading/src/shift/, where the measure, the contribution and
 // the Jacobians are described; docs/shift-mappings.md.
 #ifndef SHIFT_GLSL
 #define SHIFT_GLSL
 
-#include "shift_reconnection.glsl"
+#include "shading/shift/reconnection.glsl"
 
 // Random replay on a regenerated path `y` (trace_vertices of the base's length and end type):
 // valid if it carries light and samples the base's lobes.

@@ -10,10 +10,10 @@
 #ifndef RESTIR_BINDINGS_GLSL
 #define RESTIR_BINDINGS_GLSL
 
-#include "scene_bindings.glsl"
-#include "reservoir.glsl"
-#include "loop_budget.glsl"
-#include "counters.glsl"
+#include "interface/scene_bindings.glsl"
+#include "shading_core/reservoir.glsl"
+#include "interface/loop_budget.glsl"
+#include "interface/counters.glsl"
 
 layout(std430, set = 0, binding = RESTIR_BINDING_REUSE_PARAMS) readonly buffer ReuseParams { REUSE_PARAMS_FIELDS };
 

@@ -1,12 +1,12 @@
 // Ray-triangle intersection and stack traversal of the flattened BVH. Expects the scene buffers
-// `triangles` and `nodes` (scene_bindings.glsl). Twin: crates/shading-core/src/bvh.rs.
+// `triangles` and `nodes` (interface/scene_bindings.glsl). Twin: crates/shading-core/src/bvh.rs.
 #ifndef BVH_GLSL
 #define BVH_GLSL
 
-#include "counters.glsl"
-#include "loop_budget.glsl"
-#include "ray_offset.glsl"
-#include "types.glsl"
+#include "interface/counters.glsl"
+#include "interface/loop_budget.glsl"
+#include "shading_core/ray_offset.glsl"
+#include "interface/types.glsl"
 
 #ifndef SCENE_ALPHA
 #define SCENE_ALPHA 0
@@ -55,10 +55,10 @@ vec3 safe_inverse(vec3 d) {
 }
 
 #if SCENE_ALPHA
-#include "alpha_trace.glsl"
+#include "shading_core/alpha_trace.glsl"
 #else
 // Closest hit when any_hit is false; the first hit found otherwise (shadow rays). With
-// SCENE_ALPHA, hits that alpha_keeps rejects do not count (alpha_trace.glsl). Stackless: the
+// SCENE_ALPHA, hits that alpha_keeps rejects do not count (shading_core/alpha_trace.glsl). Stackless: the
 // uniform control flow suits SIMD CPUs (lavapipe) and keeps register pressure low on GPUs.
 Hit bvh_traverse(vec3 o, vec3 d, float tmax, bool any_hit) {
     Hit hit;

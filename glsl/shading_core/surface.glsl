@@ -4,9 +4,9 @@
 #ifndef SURFACE_GLSL
 #define SURFACE_GLSL
 
-#include "sampling.glsl"
-#include "surface_bindings.glsl"
-#include "types.glsl"
+#include "shading_core/sampling.glsl"
+#include "interface/surface_bindings.glsl"
+#include "interface/types.glsl"
 
 struct SurfaceHit {
     vec3 normal;        // unit, interpolated (the face normal where there is none); not flipped

@@ -6,7 +6,7 @@
 #define GRIS_GLSL
 
 #include "shader_interface.glsl"
-#include "loop_budget.glsl"
+#include "interface/loop_budget.glsl"
 
 #ifndef MIS_MODE
 #define MIS_MODE MIS_GBH

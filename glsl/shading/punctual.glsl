@@ -1,9 +1,9 @@
-// Shadow rays towards punctual lights. Expects bvh.glsl and lights.glsl. Twin: crates/shading/src/lights.rs.
+// Shadow rays towards punctual lights. Expects shading_core/bvh.glsl and shading/lights.glsl. Twin: crates/shading/src/lights.rs.
 #ifndef PUNCTUAL_GLSL
 #define PUNCTUAL_GLSL
 
-#include "bvh.glsl"
-#include "lights.glsl"
+#include "shading_core/bvh.glsl"
+#include "shading/lights.glsl"
 
 // The shadow ray from surface point x (normal n, on triangle index tri) to a punctual light along
 // the unit `dir` at distance `dist` (+inf: a directional light). Only x is offset: the light is a

@@ -4,11 +4,11 @@
 #ifndef SHIFT_VERTEX_GLSL
 #define SHIFT_VERTEX_GLSL
 
-#include "bsdf.glsl"
-#include "bvh.glsl"
-#include "lights.glsl"
-#include "punctual.glsl"
-#include "shading_frame.glsl"
+#include "shading_core/bsdf.glsl"
+#include "shading_core/bvh.glsl"
+#include "shading/lights.glsl"
+#include "shading/punctual.glsl"
+#include "scene/hit_surface.glsl"
 
 const float SHIFT_RAY_TMAX = 1e30;
 

@@ -5,7 +5,7 @@
 #ifndef SHIFT_RECONNECTION_GLSL
 #define SHIFT_RECONNECTION_GLSL
 
-#include "shift_path.glsl"
+#include "shading/shift/path.glsl"
 
 struct Link {
     vec3 dir;

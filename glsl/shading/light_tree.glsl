@@ -3,12 +3,12 @@
 // and stored in the emitter buffer right after the emitter rows: a header row (directional light
 // count, node count, 0, 0), then LIGHT_NODE_ROWS rows per node.
 // Directional lights are not in the tree: NEE takes each of them (light_select_pmf). Expects `emitters` and the
-// scene parameters (scene_bindings.glsl). Twin: crates/shading/src/light_tree.rs.
+// scene parameters (interface/scene_bindings.glsl). Twin: crates/shading/src/light_tree.rs.
 #ifndef LIGHT_TREE_GLSL
 #define LIGHT_TREE_GLSL
 
-#include "loop_budget.glsl"
-#include "types.glsl"
+#include "interface/loop_budget.glsl"
+#include "interface/types.glsl"
 
 uvec4 emitter_words(uint row) {
     Emitter e = emitters[row];
@@ -129,7 +129,7 @@ float env_select_prob() { return scene_env.w; }
 uint directional_row(uint k) { return emitter_count - directional_count() + k; }
 
 // Directional lights are not chosen: NEE estimates every one of them at every vertex
-// (sample_directional in lights.glsl), with probability 1, beside the one light it draws here
+// (sample_directional in shading/lights.glsl), with probability 1, beside the one light it draws here
 // from the tree. A one-sample choice between a sun and the tree's lamps gave a lamp fewer
 // samples wherever the sun outshone it, and wasted the sun's where the lamp's fixture shaded it
 // (docs/light-sampling.md).

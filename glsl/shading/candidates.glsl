@@ -2,17 +2,17 @@
 // prefix that ends on a light, by NEE at a vertex (the drawn light and every directional light,
 // each a technique of its own) or by a BSDF-sampled hit. A path either
 // technique can make is offered by both, each weighted by the balance heuristic
-// (end_mis_weight in shift_vertex.glsl): the two weighted integrands sum to the path's, and each is a
+// (end_mis_weight in shading/shift/vertex.glsl): the two weighted integrands sum to the path's, and each is a
 // function of the path that the shifts evaluate anew (the end type travels in the record). The
-// paths are built with the steps trace_vertices() in shift_path.glsl regenerates them with
+// paths are built with the steps trace_vertices() in shading/shift/path.glsl regenerates them with
 // (nee_vertex, bsdf_vertex). Expects the scene bindings and the pass counters
-// local_nonfinite_weights and local_candidates_dropped (restir_bindings.glsl; an oracle kernel
+// local_nonfinite_weights and local_candidates_dropped (interface/restir_bindings.glsl; an oracle kernel
 // declares its own). Twin: crates/shading/src/candidates.rs.
 #ifndef RESTIR_CANDIDATES_GLSL
 #define RESTIR_CANDIDATES_GLSL
 
-#include "reservoir.glsl"
-#include "shift.glsl"
+#include "shading_core/reservoir.glsl"
+#include "shading/shift.glsl"
 
 // A candidate of the path being traced, described against that path: its first `count`
 // vertices, the last replaced by a NEE light vertex when `nee_end`. The path only grows, so

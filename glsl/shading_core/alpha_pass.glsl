@@ -1,4 +1,4 @@
-// Alpha tests out of the triangle loops (glsl/bvh.glsl, glsl/trace_pair.glsl with SCENE_ALPHA):
+// Alpha tests out of the triangle loops (glsl/shading_core/bvh.glsl, glsl/shading_core/trace_pair.glsl with SCENE_ALPHA):
 // llvmpipe runs every branch of a loop body under a mask, so a test inside the loop would cost its
 // texture lookup on every iteration where any lane meets a triangle. A traversal pass instead
 // records, per ray, the nearest hit on a triangle without alpha testing and the nearest
@@ -11,7 +11,7 @@
 #ifndef ALPHA_PASS_GLSL
 #define ALPHA_PASS_GLSL
 
-#include "alpha.glsl"
+#include "shading_core/alpha.glsl"
 
 struct AlphaPass {
     Hit opaque;        // nearest hit on a triangle without alpha testing; t = tmax, NO_HIT if none

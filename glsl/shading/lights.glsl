@@ -1,17 +1,17 @@
 // Next-event estimation: emissive triangles and point and spot lights chosen by their likely
-// contribution at the shading point through the light tree (light_tree.glsl), uniform area
+// contribution at the shading point through the light tree (shading/light_tree.glsl), uniform area
 // sampling, and the environment beside them with a fixed probability; every directional light
 // besides, at every vertex (sample_directional). A punctual light's sample is a delta: pdf is
 // the discrete probability of choosing it (1 for a directional light), radiance is
 // I·falloff/d² (or E), and MIS gives it weight 1. Expects `triangles`,
-// `materials`, `emitters` and the scene parameters (scene_bindings.glsl). Twin: crates/shading/src/lights.rs.
+// `materials`, `emitters` and the scene parameters (interface/scene_bindings.glsl). Twin: crates/shading/src/lights.rs.
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
 
-#include "light_tree.glsl"
-#include "sampling.glsl"
-#include "texture.glsl"
-#include "types.glsl"
+#include "shading/light_tree.glsl"
+#include "shading_core/sampling.glsl"
+#include "shading_core/texture.glsl"
+#include "interface/types.glsl"
 
 // Specialisation like the BSDF lobes: a scene without an environment or without emissive
 // triangles compiles that half of NEE out. Both default to on.

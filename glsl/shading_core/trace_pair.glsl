@@ -3,11 +3,11 @@
 // llvmpipe runs 8 lanes in lockstep, executes every branch of a loop body under a mask and loads
 // divergent buffer elements one lane and one word at a time, so the cost of a traversal is its
 // loop iterations times the words it loads; a pair shares both (docs/performance.md).
-// Expects the scene buffers (scene_bindings.glsl). Twin: trace_pair in crates/shading-core/src/bvh.rs.
+// Expects the scene buffers (interface/scene_bindings.glsl). Twin: trace_pair in crates/shading-core/src/bvh.rs.
 #ifndef TRACE_PAIR_GLSL
 #define TRACE_PAIR_GLSL
 
-#include "bvh.glsl"
+#include "shading_core/bvh.glsl"
 
 // 1: small scenes bound as uniform buffers test every triangle in index order; no node is loaded
 // and every lane runs the same iterations. 0: the BVH, traversed once for both rays.
@@ -23,7 +23,7 @@ struct PairRay {
 };
 
 #if SCENE_ALPHA
-#include "alpha_trace_pair.glsl"
+#include "shading_core/alpha_trace_pair.glsl"
 #elif SCENE_BRUTE_FORCE
 void trace_pair(PairRay closest, PairRay shadow, out Hit hit, out bool occluded) {
     hit = Hit(closest.tmax, NO_HIT, vec2(0.0));

@@ -26,7 +26,7 @@
 #define SCENE_ADDRESSED 0
 #endif
 #if SCENE_ADDRESSED && (SCENE_SURFACE || SCENE_TEXTURES)
-// In the addressed layout (glsl/scene_bindings.glsl) the attributes (144 bytes a triangle, the
+// In the addressed layout (glsl/interface/scene_bindings.glsl) the attributes (144 bytes a triangle, the
 // largest per-triangle array) and the texels are reached by device address too: their bindings
 // hold the address and the element count, and the names below keep their meaning.
 #extension GL_EXT_buffer_reference : require

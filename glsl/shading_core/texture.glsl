@@ -4,7 +4,7 @@
 #ifndef TEXTURE_GLSL
 #define TEXTURE_GLSL
 
-#include "surface.glsl"
+#include "shading_core/surface.glsl"
 
 #if SCENE_TEXTURES
 float srgb_to_linear(float c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }

@@ -4,10 +4,10 @@
 #ifndef SHIFT_PATH_GLSL
 #define SHIFT_PATH_GLSL
 
-#include "path_record.glsl"
-#include "rng.glsl"
-#include "shift_result.glsl"
-#include "shift_vertex.glsl"
+#include "shading_core/path_record.glsl"
+#include "shading_core/rng.glsl"
+#include "shading/shift/result.glsl"
+#include "shading/shift/vertex.glsl"
 
 // A path x1..xk. Its vertices, lobes and weights are not members but the invocation's rows of
 // the shared arrays below, so an invocation builds one path at a time: lavapipe turns every

@@ -1,10 +1,10 @@
-// What every shift returns (shift_path.glsl, shift_reconnection.glsl, shift.glsl) and what the
-// reuse loop (resample_inputs.glsl) consumes; apart from the shifts, so that an oracle kernel of
+// What every shift returns (shading/shift/path.glsl, shading/shift/reconnection.glsl, shading/shift.glsl) and what the
+// reuse loop (shading/resample_inputs.glsl) consumes; apart from the shifts, so that an oracle kernel of
 // the loop can return its own. Twin: ShiftResult in crates/shading/src/shift/path.rs.
 #ifndef SHIFT_RESULT_GLSL
 #define SHIFT_RESULT_GLSL
 
-#include "path_record.glsl"
+#include "shading_core/path_record.glsl"
 
 struct ShiftResult {
     bool valid;

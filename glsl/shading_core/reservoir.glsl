@@ -5,7 +5,7 @@
 #ifndef RESERVOIR_GLSL
 #define RESERVOIR_GLSL
 
-#include "path_record.glsl"
+#include "shading_core/path_record.glsl"
 
 struct Reservoir {
     PathRecord record;

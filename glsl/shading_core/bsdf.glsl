@@ -6,8 +6,8 @@
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
 
-#include "sampling.glsl"
-#include "types.glsl"
+#include "shading_core/sampling.glsl"
+#include "interface/types.glsl"
 
 // Kernels are specialised to the lobes a scene uses (lavapipe executes both sides of a divergent
 // branch, so unused lobes would cost time); each defaults to on, as in the oracle kernels.

@@ -3,7 +3,7 @@
 #ifndef RAY_OFFSET_GLSL
 #define RAY_OFFSET_GLSL
 
-#include "types.glsl"
+#include "interface/types.glsl"
 
 // 2^-17 = 128 unit roundoffs of f32 per unit of |v0| + |e1| + |e2| (see crates/shading-core/src/ray_offset.rs).
 
