@@ -15,7 +15,7 @@ use super::method_spec::{MethodRenderer, MethodSpec};
 use super::render_output::{compile_progress, print_compile_summary};
 use super::{finish_device, load_with_options, open_device};
 use restir_pt::metrics::quantile;
-use restir_pt::render::{PassTimes, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_COUNT, PASS_NAMES};
+use restir_pt::render::{PassTimes, RenderSettings, Restir, RestirSettings, SceneGpu, SceneInfo, PASS_NAMES};
 use restir_pt::scene::camera_on_path;
 
 /// `restir-pt profile`.
@@ -43,7 +43,15 @@ pub struct ProfileArgs {
     pub device: DeviceArgs,
 }
 
-const PASS_COLOURS: [&str; PASS_COUNT] = ["#4c72b0", "#dd8452", "#55a868", "#c44e52"];
+/// Colours of the timers' bars, taken in turn (seaborn's "deep" palette), so a timer added to
+/// the pass table gets one.
+const PASS_COLOURS: [&str; 8] = [
+    "#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c",
+];
+
+fn pass_colour(pass: usize) -> &'static str {
+    PASS_COLOURS[pass % PASS_COLOURS.len()]
+}
 
 /// A stacked bar per frame, one colour per pass.
 fn stacked_bar_svg(times: &[PassTimes], title: &str) -> String {
@@ -65,7 +73,7 @@ fn stacked_bar_svg(times: &[PassTimes], title: &str) -> String {
                 svg,
                 "<rect x=\"{x:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{height:.1}\" fill=\"{}\"><title>frame {f} {}: {ms:.2} ms</title></rect>",
                 (bar * 0.8).max(1.0),
-                PASS_COLOURS[p],
+                pass_colour(p),
                 PASS_NAMES[p]
             );
         }
@@ -84,7 +92,7 @@ fn stacked_bar_svg(times: &[PassTimes], title: &str) -> String {
         let _ = writeln!(
             svg,
             "<rect x=\"{x}\" y=\"8\" width=\"12\" height=\"12\" fill=\"{}\"/><text x=\"{}\" y=\"19\">{name}</text>",
-            PASS_COLOURS[p],
+            pass_colour(p),
             x + 16.0
         );
     }

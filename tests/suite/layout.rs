@@ -283,6 +283,51 @@ fn records_and_constants_are_declared_only_in_rust() {
     assert!(problems.is_empty(), "written by hand:\n{}", problems.join("\n"));
 }
 
+/// Every repository path that a source file, kernel or document names (`glsl/...`,
+/// `crates/.../*.rs`, `docs/*.md`, ...) exists: comments that point at moved or deleted files
+/// are how twins drift apart. Placeholders in capitals (`scenes/NAME.gltf`) are not paths.
+#[test]
+fn no_source_or_document_names_a_missing_file() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for ext in ["rs", "md", "glsl", "comp", "py", "sh", "toml"] {
+        repository_files(root, ext, &mut files);
+    }
+    let folders = [
+        "glsl", "crates", "src", "tests", "docs", "tools", "scenes", "python", "examples", "fuzz",
+    ];
+    let extensions = [".rs", ".glsl", ".comp", ".md", ".py", ".sh", ".gltf", ".toml"];
+    let path_char = |c: char| c.is_ascii_alphanumeric() || "_./-".contains(c);
+    let mut missing = Vec::new();
+    for file in &files {
+        let text = std::fs::read_to_string(file).expect("readable source");
+        for (start, _) in text.match_indices('/') {
+            let head = text[..start]
+                .char_indices()
+                .rev()
+                .find(|&(_, c)| !path_char(c))
+                .map_or(0, |(i, c)| i + c.len_utf8());
+            if !folders.contains(&&text[head..start]) || text[..head].ends_with(|c: char| path_char(c) || c == '/') {
+                continue;
+            }
+            let end = text[start..].find(|c: char| !path_char(c)).map_or(text.len(), |i| start + i);
+            let path = text[head..end].trim_end_matches('.');
+            let Some(ext) = extensions.iter().find(|e| path.ends_with(*e)) else {
+                continue;
+            };
+            let placeholder = path[..path.len() - ext.len()]
+                .split('/')
+                .any(|w| !w.is_empty() && w.chars().all(|c| c.is_ascii_uppercase()));
+            if !placeholder && !root.join(path).exists() {
+                missing.push(format!("{}: {path}", file.strip_prefix(root).unwrap_or(file).display()));
+            }
+        }
+    }
+    missing.sort();
+    missing.dedup();
+    assert!(missing.is_empty(), "names of files that do not exist:\n{}", missing.join("\n"));
+}
+
 /// glsl/generated/ holds the header the build generates, for GLSL tools (`glslangValidator -I
 /// glsl/generated`), which cannot run the build script. `RESTIR_PT_BLESS=1` rewrites it.
 #[test]
