@@ -30,8 +30,11 @@ mod record;
 
 const LOCAL_SIZE: u32 = IMAGE_LOCAL_SIZE;
 
-/// The push block of a warm-up dispatch (the kernels' one push word, the pass's seed).
-const WARM_UP_PUSH: [u8; 4] = [0; 4];
+/// The push block of every dispatch: the index of its pass-table entry (`ReuseParams::passes`).
+const PUSH_BYTES: u32 = std::mem::size_of::<u32>() as u32;
+
+/// The push block of a warm-up dispatch, which writes nothing.
+const WARM_UP_PUSH: [u8; PUSH_BYTES as usize] = [0; PUSH_BYTES as usize];
 
 /// Kernels `compiled` split in two sets of about equal SPIR-V size (llvmpipe's compile time
 /// grows with it), the largest kernel in the first: indices into `compiled`, each set in
@@ -243,7 +246,7 @@ impl Restir {
         let mut build_one = |this: &mut Self, i: usize, compiled: &CompiledKernel| -> Result<()> {
             built += 1;
             let pass = todo[i].declaration();
-            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, compiled, pass_layout(&scene_gpu, pass), 4)?;
+            let mut k = scene_gpu.kernel_with_spirv(jobs[i].0, compiled, pass_layout(&scene_gpu, pass), PUSH_BYTES)?;
             if let Some(variant) = pass.variant {
                 k.set_variant(variant);
             }
