@@ -279,4 +279,13 @@ struct ReuseOracleOutput {
     uvec2 pad;                       // Zero; pads the record to 48 bytes.
 };
 
+struct RngOracleOutput {
+    uvec4 pcg4d;                     // `pcg4d(k)`, the hash of all four words.
+    uint path_seed;                  // `path_seed(k.x, k.y, k.z)`: k read as (pixel, sample index, seed).
+    uint pad0;                       // Zero; this and the next two align `uniforms` to 16 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+    vec4 uniforms;                   // `rng_uniform4(k.x, k.y, k.z)`: k read as (seed, vertex, stream); four uniforms in [0, 1).
+};
+
 #endif

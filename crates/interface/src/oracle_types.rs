@@ -48,3 +48,24 @@ gpu_record! {
         pub pad: [u32; 2],
     }
 }
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/rng_oracle.comp writes per key k (its input, one `uvec4` per item): the
+    /// random numbers of crates/shading-core/src/rng.rs, compared bit for bit.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct RngOracleOutput {
+        /// `pcg4d(k)`, the hash of all four words.
+        pub pcg4d: [u32; 4],
+        /// `path_seed(k.x, k.y, k.z)`: k read as (pixel, sample index, seed).
+        pub path_seed: u32,
+        /// Zero; this and the next two align `uniforms` to 16 bytes.
+        pub pad0: u32,
+        /// Zero.
+        pub pad1: u32,
+        /// Zero.
+        pub pad2: u32,
+        /// `rng_uniform4(k.x, k.y, k.z)`: k read as (seed, vertex, stream); four uniforms in [0, 1).
+        pub uniforms: [f32; 4],
+    }
+}

@@ -439,6 +439,7 @@ pub fn records() -> Vec<RecordInfo> {
         MaterialTextures::info(),
         ReuseToyInput::info(),
         ReuseOracleOutput::info(),
+        RngOracleOutput::info(),
     ]
 }
 
