@@ -288,4 +288,27 @@ struct RngOracleOutput {
     vec4 uniforms;                   // `rng_uniform4(k.x, k.y, k.z)`: k read as (seed, vertex, stream); four uniforms in [0, 1).
 };
 
+struct SamplingOracleInput {
+    vec4 u;                          // Four uniforms in [0, 1): xy feed the 2D warps, zw the disk and the scalar functions.
+    vec3 direction;                  // A direction, not necessarily unit: the normal of the frame (normalized by the kernel) and, with |z| + 0.001 for z, the GGX outgoing direction.
+    float alpha;                     // The GGX roughness alpha of `sample_ggx_vndf`.
+};
+
+struct SamplingOracleOutput {
+    vec3 cosine_hemisphere;          // `sample_cosine_hemisphere(u.xy)`, local frame (z up).
+    float cosine_pdf;                // `pdf_cosine_hemisphere(2 u.z - 1)`: the density of a direction of that cosine, per steradian.
+    vec3 uniform_sphere;             // `sample_uniform_sphere(u.xy)`.
+    float power_heuristic;           // `power_heuristic(u.z, u.w)`.
+    vec2 triangle;                   // `sample_triangle(u.xy)`: barycentrics (b1, b2).
+    vec2 concentric_disk;            // `sample_concentric_disk(u.zw)`: a point of the unit disk.
+    vec3 ggx_vndf;                   // `sample_ggx_vndf(wo, alpha, u.xy)`: a visible microfacet normal, local frame, wo the input direction with |z| + 0.001 for z, normalized.
+    float pad0;                      // Zero.
+    vec3 onb_tangent;                // The tangent t of `build_onb(n)`, world space.
+    float pad1;                      // Zero.
+    vec3 onb_bitangent;              // The bitangent b of `build_onb(n)`, world space.
+    float pad2;                      // Zero.
+    vec3 round_trip;                 // `to_world(to_local(u.xyz, t, b, n), t, b, n)`: u.xyz again, within rounding.
+    float pad3;                      // Zero.
+};
+
 #endif

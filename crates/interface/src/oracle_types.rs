@@ -69,3 +69,57 @@ gpu_record! {
         pub uniforms: [f32; 4],
     }
 }
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/sampling_oracle.comp: uniforms and a direction for the warps of
+    /// crates/shading-core/src/sampling.rs.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SamplingOracleInput {
+        /// Four uniforms in [0, 1): xy feed the 2D warps, zw the disk and the scalar functions.
+        pub u: [f32; 4],
+        /// A direction, not necessarily unit: the normal of the frame (normalized by the kernel)
+        /// and, with |z| + 0.001 for z, the GGX outgoing direction.
+        pub direction: [f32; 3],
+        /// The GGX roughness alpha of `sample_ggx_vndf`.
+        pub alpha: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/sampling_oracle.comp writes per item, u and n the input's uniforms and
+    /// normalized direction; directions are unit vectors in the frame they are sampled in.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SamplingOracleOutput {
+        /// `sample_cosine_hemisphere(u.xy)`, local frame (z up).
+        pub cosine_hemisphere: [f32; 3],
+        /// `pdf_cosine_hemisphere(2 u.z - 1)`: the density of a direction of that cosine, per steradian.
+        pub cosine_pdf: f32,
+        /// `sample_uniform_sphere(u.xy)`.
+        pub uniform_sphere: [f32; 3],
+        /// `power_heuristic(u.z, u.w)`.
+        pub power_heuristic: f32,
+        /// `sample_triangle(u.xy)`: barycentrics (b1, b2).
+        pub triangle: [f32; 2],
+        /// `sample_concentric_disk(u.zw)`: a point of the unit disk.
+        pub concentric_disk: [f32; 2],
+        /// `sample_ggx_vndf(wo, alpha, u.xy)`: a visible microfacet normal, local frame, wo the
+        /// input direction with |z| + 0.001 for z, normalized.
+        pub ggx_vndf: [f32; 3],
+        /// Zero.
+        pub pad0: f32,
+        /// The tangent t of `build_onb(n)`, world space.
+        pub onb_tangent: [f32; 3],
+        /// Zero.
+        pub pad1: f32,
+        /// The bitangent b of `build_onb(n)`, world space.
+        pub onb_bitangent: [f32; 3],
+        /// Zero.
+        pub pad2: f32,
+        /// `to_world(to_local(u.xyz, t, b, n), t, b, n)`: u.xyz again, within rounding.
+        pub round_trip: [f32; 3],
+        /// Zero.
+        pub pad3: f32,
+    }
+}

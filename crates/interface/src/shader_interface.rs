@@ -440,6 +440,8 @@ pub fn records() -> Vec<RecordInfo> {
         ReuseToyInput::info(),
         ReuseOracleOutput::info(),
         RngOracleOutput::info(),
+        SamplingOracleInput::info(),
+        SamplingOracleOutput::info(),
     ]
 }
 
