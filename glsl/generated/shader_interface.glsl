@@ -311,4 +311,30 @@ struct SamplingOracleOutput {
     float pad3;                      // Zero.
 };
 
+struct OracleRay {
+    vec3 origin;                     // The ray's origin.
+    float tmax;                      // The largest ray parameter that counts, in units of |dir| (0: an inactive ray).
+    vec3 dir;                        // The ray's direction, not necessarily unit.
+    float pad;                       // Zero; pads the record to 32 bytes.
+};
+
+struct OracleHit {
+    float t;                         // The ray parameter of the hit, in units of |dir|.
+    uint triangle;                   // The triangle hit (in the scene's BVH leaf order), or `NO_HIT`.
+    vec2 bary;                       // The barycentrics (b1, b2) of the hit, weights of vertices 1 and 2.
+};
+
+struct TracePairOracleInput {
+    OracleRay closest;               // The closest-hit ray.
+    OracleRay shadow;                // The shadow ray, occluded by any hit before its tmax.
+};
+
+struct TracePairOracleOutput {
+    OracleHit hit;                   // The closest ray's hit.
+    uint occluded;                   // 1 if the shadow ray is occluded, else 0.
+    uint pad0;                       // Zero; this and the next two pad the record to 32 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+};
+
 #endif

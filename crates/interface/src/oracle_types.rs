@@ -123,3 +123,63 @@ gpu_record! {
         pub pad3: f32,
     }
 }
+
+gpu_record! {
+    struct;
+    /// A ray given to an oracle kernel; positions and directions in scene coordinates.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct OracleRay {
+        /// The ray's origin.
+        pub origin: [f32; 3],
+        /// The largest ray parameter that counts, in units of |dir| (0: an inactive ray).
+        pub tmax: f32,
+        /// The ray's direction, not necessarily unit.
+        pub dir: [f32; 3],
+        /// Zero; pads the record to 32 bytes.
+        pub pad: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// A closest hit as an oracle kernel writes it (GLSL `Hit`, Rust `restir_pt_shading_core::bvh::Hit`).
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct OracleHit {
+        /// The ray parameter of the hit, in units of |dir|.
+        pub t: f32,
+        /// The triangle hit (in the scene's BVH leaf order), or `NO_HIT`.
+        pub triangle: u32,
+        /// The barycentrics (b1, b2) of the hit, weights of vertices 1 and 2.
+        pub bary: [f32; 2],
+    }
+}
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/trace_pair_oracle.comp: the two rays `trace_pair` traces together.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct TracePairOracleInput {
+        /// The closest-hit ray.
+        pub closest: OracleRay,
+        /// The shadow ray, occluded by any hit before its tmax.
+        pub shadow: OracleRay,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/trace_pair_oracle.comp writes per item: `trace_pair`'s results.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct TracePairOracleOutput {
+        /// The closest ray's hit.
+        pub hit: OracleHit,
+        /// 1 if the shadow ray is occluded, else 0.
+        pub occluded: u32,
+        /// Zero; this and the next two pad the record to 32 bytes.
+        pub pad0: u32,
+        /// Zero.
+        pub pad1: u32,
+        /// Zero.
+        pub pad2: u32,
+    }
+}

@@ -442,6 +442,10 @@ pub fn records() -> Vec<RecordInfo> {
         RngOracleOutput::info(),
         SamplingOracleInput::info(),
         SamplingOracleOutput::info(),
+        OracleRay::info(),
+        OracleHit::info(),
+        TracePairOracleInput::info(),
+        TracePairOracleOutput::info(),
     ]
 }
 
