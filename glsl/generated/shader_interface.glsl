@@ -337,4 +337,25 @@ struct TracePairOracleOutput {
     uint pad2;                       // Zero.
 };
 
+struct BsdfOracleInput {
+    vec3 geometric_normal;           // The geometric normal.
+    float pad0;                      // Zero.
+    vec3 shading_normal;             // The shading normal.
+    float pad1;                      // Zero.
+    vec3 wo;                         // The outgoing direction wo, pointing away from the surface.
+    float pad2;                      // Zero.
+    vec3 wi;                         // The incident direction wi of `bsdf_eval_pdf`, pointing away from the surface.
+    float pad3;                      // Zero.
+    vec4 u;                          // The uniforms of `bsdf_sample` (xy: direction, z: lobe choice, w: reflect/refract choice).
+};
+
+struct BsdfOracleOutput {
+    vec3 f;                          // The BSDF value f(wo, wi), linear RGB, per steradian.
+    float pdf;                       // The solid-angle pdf of sampling wi, per steradian.
+    vec3 sample_wi;                  // The sampled direction, world space.
+    float sample_pdf;                // The sampled direction's solid-angle pdf, per steradian.
+    vec3 sample_weight;              // The sample's weight f |cos| / pdf, linear RGB.
+    uint sample_lobe;                // The lobe sampled (`LOBE_*` bits); `LOBE_NONE` if sampling failed.
+};
+
 #endif

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use restir_pt::oracle_types::{BsdfOracleInput, BsdfOracleOutput};
 use restir_pt::render::SceneGpu;
 use restir_pt::vk::{BindingSlot, BoundBuffer, Buffer, Context, ContextOptions, Kernel};
 
@@ -87,11 +88,26 @@ pub fn run_scene_oracle<T: bytemuck::Pod>(
     run_built_oracle(ctx, build, &scene_gpu.buffers(frame), inputs, output_words, count)
 }
 
-/// Runs oracle/bsdf_oracle.comp (`bsdf_eval_pdf` and `bsdf_sample`): `inputs` holds 5 vec4s per
-/// material (geometric normal, shading normal, wo, wi, u); 3 vec4s come back per material
-/// ((f, pdf), (sampled wi, pdf), (weight, lobe bits)).
-pub fn run_bsdf_oracle(ctx: &Arc<Context>, materials: &[restir_pt::gpu_types::Material], inputs: &[glam::Vec4]) -> Vec<glam::Vec4> {
-    assert_eq!(inputs.len(), 5 * materials.len(), "5 input rows per material");
+/// The input of oracle/bsdf_oracle.comp for normals `ng` (geometric) and `ns` (shading),
+/// directions `wo` and `wi` and `bsdf_sample`'s uniforms `u`.
+pub fn bsdf_input(ng: glam::Vec3, ns: glam::Vec3, wo: glam::Vec3, wi: glam::Vec3, u: glam::Vec4) -> BsdfOracleInput {
+    BsdfOracleInput {
+        geometric_normal: ng.to_array(),
+        shading_normal: ns.to_array(),
+        wo: wo.to_array(),
+        wi: wi.to_array(),
+        u: u.to_array(),
+        ..Default::default()
+    }
+}
+
+/// Runs oracle/bsdf_oracle.comp (`bsdf_eval_pdf` and `bsdf_sample`) on one input per material.
+pub fn run_bsdf_oracle(
+    ctx: &Arc<Context>,
+    materials: &[restir_pt::gpu_types::Material],
+    inputs: &[BsdfOracleInput],
+) -> Vec<BsdfOracleOutput> {
+    assert_eq!(inputs.len(), materials.len(), "one input per material");
     run_oracle(
         ctx,
         "oracle/bsdf_oracle.comp",
@@ -100,7 +116,7 @@ pub fn run_bsdf_oracle(ctx: &Arc<Context>, materials: &[restir_pt::gpu_types::Ma
             ("Materials", bytemuck::cast_slice(materials)),
             ("Inputs", bytemuck::cast_slice(inputs)),
         ],
-        materials.len() * 12,
+        materials.len() * std::mem::size_of::<BsdfOracleOutput>() / 4,
         materials.len() as u32,
     )
 }

@@ -183,3 +183,51 @@ gpu_record! {
         pub pad2: u32,
     }
 }
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/bsdf_oracle.comp (the material is the item's entry of the
+    /// `Materials` binding): the directions of `bsdf_eval_pdf` and the uniforms of
+    /// `bsdf_sample`, all vectors unit and in world space.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct BsdfOracleInput {
+        /// The geometric normal.
+        pub geometric_normal: [f32; 3],
+        /// Zero.
+        pub pad0: f32,
+        /// The shading normal.
+        pub shading_normal: [f32; 3],
+        /// Zero.
+        pub pad1: f32,
+        /// The outgoing direction wo, pointing away from the surface.
+        pub wo: [f32; 3],
+        /// Zero.
+        pub pad2: f32,
+        /// The incident direction wi of `bsdf_eval_pdf`, pointing away from the surface.
+        pub wi: [f32; 3],
+        /// Zero.
+        pub pad3: f32,
+        /// The uniforms of `bsdf_sample` (xy: direction, z: lobe choice, w: reflect/refract choice).
+        pub u: [f32; 4],
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/bsdf_oracle.comp writes per item: `bsdf_eval_pdf(wi)` and `bsdf_sample(u)`.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct BsdfOracleOutput {
+        /// The BSDF value f(wo, wi), linear RGB, per steradian.
+        pub f: [f32; 3],
+        /// The solid-angle pdf of sampling wi, per steradian.
+        pub pdf: f32,
+        /// The sampled direction, world space.
+        pub sample_wi: [f32; 3],
+        /// The sampled direction's solid-angle pdf, per steradian.
+        pub sample_pdf: f32,
+        /// The sample's weight f |cos| / pdf, linear RGB.
+        pub sample_weight: [f32; 3],
+        /// The lobe sampled (`LOBE_*` bits); `LOBE_NONE` if sampling failed.
+        pub sample_lobe: u32,
+    }
+}

@@ -446,6 +446,8 @@ pub fn records() -> Vec<RecordInfo> {
         OracleHit::info(),
         TracePairOracleInput::info(),
         TracePairOracleOutput::info(),
+        BsdfOracleInput::info(),
+        BsdfOracleOutput::info(),
     ]
 }
 
