@@ -358,4 +358,23 @@ struct BsdfOracleOutput {
     uint sample_lobe;                // The lobe sampled (`LOBE_*` bits); `LOBE_NONE` if sampling failed.
 };
 
+struct GrisOracleOffer {
+    vec3 contribution;               // The candidate's contribution f, linear RGB.
+    float target;                    // Its target p̂.
+    float weight;                    // Its resampling weight w; zero or less: the input offers nothing (a failed shift).
+    float u;                         // The uniform in [0, 1) that decides whether it replaces the chosen candidate.
+    uint lost;                       // 1 if recording the candidate fails when it is chosen (`record_chosen`'s loss), else 0.
+    uint pad;                        // Zero; pads the record to 32 bytes.
+};
+
+struct GrisOracleOutput {
+    vec4 mis_weights[3];             // The MIS weight m_i of input i at `[i / 4][i % 4]` for i < n; zero past n.
+    vec3 expected;                   // The expectation of f(Y) W_Y over the choice, linear RGB.
+    int chosen_input;                // The input the chosen candidate came from; -1: none.
+    float weight;                    // W of the result.
+    float confidence;                // M of the result.
+    float pad0;                      // Zero; this and the next pad the record to 80 bytes.
+    float pad1;                      // Zero.
+};
+
 #endif

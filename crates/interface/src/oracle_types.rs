@@ -231,3 +231,46 @@ gpu_record! {
         pub sample_lobe: u32,
     }
 }
+
+gpu_record! {
+    struct;
+    /// One candidate that an input offers to the resampler of glsl/oracle/gris_oracle.comp.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct GrisOracleOffer {
+        /// The candidate's contribution f, linear RGB.
+        pub contribution: [f32; 3],
+        /// Its target p̂.
+        pub target: f32,
+        /// Its resampling weight w; zero or less: the input offers nothing (a failed shift).
+        pub weight: f32,
+        /// The uniform in [0, 1) that decides whether it replaces the chosen candidate.
+        pub u: f32,
+        /// 1 if recording the candidate fails when it is chosen (`record_chosen`'s loss), else 0.
+        pub lost: u32,
+        /// Zero; pads the record to 32 bytes.
+        pub pad: u32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/gris_oracle.comp writes per resampling of n inputs: the MIS weights of
+    /// `mis_weight` and the reservoir of `resampler_finish`.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct GrisOracleOutput {
+        /// The MIS weight m_i of input i at `[i / 4][i % 4]` for i < n; zero past n.
+        pub mis_weights: [[f32; 4]; 3],
+        /// The expectation of f(Y) W_Y over the choice, linear RGB.
+        pub expected: [f32; 3],
+        /// The input the chosen candidate came from; -1: none.
+        pub chosen_input: i32,
+        /// W of the result.
+        pub weight: f32,
+        /// M of the result.
+        pub confidence: f32,
+        /// Zero; this and the next pad the record to 80 bytes.
+        pub pad0: f32,
+        /// Zero.
+        pub pad1: f32,
+    }
+}

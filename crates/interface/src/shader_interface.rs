@@ -448,6 +448,8 @@ pub fn records() -> Vec<RecordInfo> {
         TracePairOracleOutput::info(),
         BsdfOracleInput::info(),
         BsdfOracleOutput::info(),
+        GrisOracleOffer::info(),
+        GrisOracleOutput::info(),
     ]
 }
 
