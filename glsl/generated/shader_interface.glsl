@@ -377,4 +377,27 @@ struct GrisOracleOutput {
     float pad1;                      // Zero.
 };
 
+struct SceneOracleInput {
+    OracleRay ray;                   // The ray of `trace_closest` and `trace_occluded`; its origin is also the shading point of `sample_light`, and its direction that point's normal.
+    vec3 light_uniforms;             // The uniforms of `sample_light` (the light choice and the point or direction on it).
+    float pad0;                      // Zero.
+    vec2 image_point;                // The image point of `camera_ray_dir`, in pixels of the frame parameters' image.
+    vec2 pad1;                       // Zero; pads the record to 64 bytes.
+};
+
+struct SceneOracleOutput {
+    OracleHit hit;                   // `trace_closest` of the ray.
+    vec3 offset_origin;              // `offset_ray_origin` of the ray's origin and direction off triangle i mod the triangle count (i the item).
+    uint occluded;                   // 1 if `trace_occluded` found the ray occluded, else 0.
+    vec3 light_dir;                  // The sampled light's direction from the shading point, unit.
+    float light_dist;                // The distance to the sampled point, scene units; infinite for the environment and distant lights.
+    vec3 light_radiance;             // The sampled radiance.
+    float light_pdf;                 // The sample's solid-angle pdf, per steradian (a probability for a punctual light).
+    vec3 camera_dir;                 // `camera_ray_dir` of the image point: camera 0's ray direction, unit.
+    uint light_triangle;             // The sampled emitter (`LightSample::triangle`): a triangle, a punctual light with `PUNCTUAL_LIGHT_BIT` set, or `NO_EMITTER` for the environment.
+    uint punctual_shadowed;          // 1 if the sample is a punctual light and `punctual_occluded` blocks it, else 0.
+    float pdf_again;                 // The sample's pdf recomputed as MIS and the shifts do (`environment_pdf`, `light_select_pmf` or `emitter_pdf`); 0 when the sample's pdf is 0.
+    uvec2 pad;                       // Zero; pads the record to 96 bytes.
+};
+
 #endif

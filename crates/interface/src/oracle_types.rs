@@ -274,3 +274,60 @@ gpu_record! {
         pub pad1: f32,
     }
 }
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/scene_oracle.comp: a ray and the random numbers of light sampling
+    /// and the camera at its origin.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SceneOracleInput {
+        /// The ray of `trace_closest` and `trace_occluded`; its origin is also the shading point
+        /// of `sample_light`, and its direction that point's normal.
+        pub ray: OracleRay,
+        /// The uniforms of `sample_light` (the light choice and the point or direction on it).
+        pub light_uniforms: [f32; 3],
+        /// Zero.
+        pub pad0: f32,
+        /// The image point of `camera_ray_dir`, in pixels of the frame parameters' image.
+        pub image_point: [f32; 2],
+        /// Zero; pads the record to 64 bytes.
+        pub pad1: [f32; 2],
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/scene_oracle.comp writes per item; positions and directions in scene
+    /// coordinates, radiance linear RGB.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SceneOracleOutput {
+        /// `trace_closest` of the ray.
+        pub hit: OracleHit,
+        /// `offset_ray_origin` of the ray's origin and direction off triangle i mod the
+        /// triangle count (i the item).
+        pub offset_origin: [f32; 3],
+        /// 1 if `trace_occluded` found the ray occluded, else 0.
+        pub occluded: u32,
+        /// The sampled light's direction from the shading point, unit.
+        pub light_dir: [f32; 3],
+        /// The distance to the sampled point, scene units; infinite for the environment and
+        /// distant lights.
+        pub light_dist: f32,
+        /// The sampled radiance.
+        pub light_radiance: [f32; 3],
+        /// The sample's solid-angle pdf, per steradian (a probability for a punctual light).
+        pub light_pdf: f32,
+        /// `camera_ray_dir` of the image point: camera 0's ray direction, unit.
+        pub camera_dir: [f32; 3],
+        /// The sampled emitter (`LightSample::triangle`): a triangle, a punctual light with
+        /// `PUNCTUAL_LIGHT_BIT` set, or `NO_EMITTER` for the environment.
+        pub light_triangle: u32,
+        /// 1 if the sample is a punctual light and `punctual_occluded` blocks it, else 0.
+        pub punctual_shadowed: u32,
+        /// The sample's pdf recomputed as MIS and the shifts do (`environment_pdf`,
+        /// `light_select_pmf` or `emitter_pdf`); 0 when the sample's pdf is 0.
+        pub pdf_again: f32,
+        /// Zero; pads the record to 96 bytes.
+        pub pad: [u32; 2],
+    }
+}

@@ -450,6 +450,8 @@ pub fn records() -> Vec<RecordInfo> {
         BsdfOracleOutput::info(),
         GrisOracleOffer::info(),
         GrisOracleOutput::info(),
+        SceneOracleInput::info(),
+        SceneOracleOutput::info(),
     ]
 }
 
