@@ -400,4 +400,63 @@ struct SceneOracleOutput {
     uvec2 pad;                       // Zero; pads the record to 96 bytes.
 };
 
+struct AlphaOracleInput {
+    vec3 origin;                     // The ray's origin.
+    float shadow_tmax;               // The shadow ray's tmax, in units of |dir| (the closest ray has none).
+    vec3 dir;                        // The ray's direction, unit.
+    uint triangle;                   // The triangle of `material_alpha` and `alpha_keeps`, and of `alpha_hash` with the ray.
+    vec2 bary;                       // The barycentrics (b1, b2) on that triangle.
+    vec2 pad;                        // Zero; pads the record to 48 bytes.
+};
+
+struct AlphaOracleOutput {
+    OracleHit hit;                   // `bvh_traverse`'s closest hit kept by alpha testing.
+    uint any_hit;                    // 1 if `bvh_traverse`'s any-hit query meets a kept hit before the shadow tmax, else 0.
+    uint pair_occluded;              // 1 if `trace_pair`'s shadow ray is occluded, else 0.
+    float hash;                      // `alpha_hash` of the ray and the item's triangle, in [0, 1).
+    float alpha;                     // `material_alpha` at the item's point: the coverage alpha, in [0, 1].
+    OracleHit pair_hit;              // `trace_pair`'s closest hit.
+    uint keeps;                      // 1 if `alpha_keeps` keeps the item's point as a hit of the ray, else 0.
+    uint pad0;                       // Zero; this and the next two pad the record to 64 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+};
+
+struct SurfaceOracleInput {
+    vec2 bary;                       // The barycentrics (b1, b2) of the point on the triangle.
+    uint triangle;                   // The triangle.
+    uint texture_index;              // The texture of `texture_lookup`.
+    vec2 lookup_uv;                  // The texture coordinates of `texture_lookup` (any real values: the address modes apply).
+    uint srgb;                       // 1 if `texture_lookup` decodes sRGB texels, else 0.
+    uint pad0;                       // Zero.
+    vec3 point;                      // The point in scene coordinates (the barycentrics' point), for `triangle_bary`.
+    float pad1;                      // Zero; pads the record to 48 bytes.
+};
+
+struct SurfaceOracleOutput {
+    vec3 normal;                     // `surface_at`'s interpolated normal.
+    float handedness;                // `surface_at`'s tangent handedness, ±1.
+    vec3 tangent;                    // `surface_at`'s tangent.
+    float pad0;                      // Zero.
+    vec2 uv0;                        // `surface_at`'s texture coordinates of set 0.
+    vec2 uv1;                        // `surface_at`'s texture coordinates of set 1.
+    vec4 texel;                      // `texture_lookup` of the input's texture and coordinates: RGBA.
+    vec3 base_color;                 // `textured_material`'s base colour.
+    float metallic;                  // `textured_material`'s metallic factor.
+    vec3 emission;                   // `textured_material`'s emission, radiance.
+    float roughness;                 // `textured_material`'s perceptual roughness.
+    vec3 normal_mapped;              // `normal_mapped`: the shading normal the normal texture gives, unit.
+    float pad1;                      // Zero.
+    vec2 bary;                       // `triangle_bary` of the input's point: barycentrics (b1, b2).
+    vec2 base_color_uv;              // `texture_coordinates` of the material's base-colour slot: the coordinates its lookup uses.
+    vec3 shading_normal;             // `shading_normal` of the point.
+    float hit_roughness;             // The roughness of the material `hit_shading` returns.
+    vec3 hit_normal;                 // The shading normal `hit_shading` returns.
+    float hit_metallic;              // The metallic factor of the material `hit_shading` returns.
+    vec3 frame_tangent;              // `texture_tangent_frame` of the material's normal texture: the tangent.
+    float frame_handedness;          // `texture_tangent_frame`'s handedness, ±1.
+    vec3 color;                      // `surface_at`'s vertex colour (COLOR_0; white without one).
+    float pad2;                      // Zero; pads the record to 192 bytes.
+};
+
 #endif

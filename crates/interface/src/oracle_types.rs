@@ -331,3 +331,131 @@ gpu_record! {
         pub pad: [u32; 2],
     }
 }
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/alpha_oracle.comp: a ray, and a point on a triangle for the
+    /// per-triangle alpha functions; scene coordinates.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct AlphaOracleInput {
+        /// The ray's origin.
+        pub origin: [f32; 3],
+        /// The shadow ray's tmax, in units of |dir| (the closest ray has none).
+        pub shadow_tmax: f32,
+        /// The ray's direction, unit.
+        pub dir: [f32; 3],
+        /// The triangle of `material_alpha` and `alpha_keeps`, and of `alpha_hash` with the ray.
+        pub triangle: u32,
+        /// The barycentrics (b1, b2) on that triangle.
+        pub bary: [f32; 2],
+        /// Zero; pads the record to 48 bytes.
+        pub pad: [f32; 2],
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/alpha_oracle.comp writes per item.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct AlphaOracleOutput {
+        /// `bvh_traverse`'s closest hit kept by alpha testing.
+        pub hit: OracleHit,
+        /// 1 if `bvh_traverse`'s any-hit query meets a kept hit before the shadow tmax, else 0.
+        pub any_hit: u32,
+        /// 1 if `trace_pair`'s shadow ray is occluded, else 0.
+        pub pair_occluded: u32,
+        /// `alpha_hash` of the ray and the item's triangle, in [0, 1).
+        pub hash: f32,
+        /// `material_alpha` at the item's point: the coverage alpha, in [0, 1].
+        pub alpha: f32,
+        /// `trace_pair`'s closest hit.
+        pub pair_hit: OracleHit,
+        /// 1 if `alpha_keeps` keeps the item's point as a hit of the ray, else 0.
+        pub keeps: u32,
+        /// Zero; this and the next two pad the record to 64 bytes.
+        pub pad0: u32,
+        /// Zero.
+        pub pad1: u32,
+        /// Zero.
+        pub pad2: u32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/surface_oracle.comp: a point on a triangle, and a texture lookup.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SurfaceOracleInput {
+        /// The barycentrics (b1, b2) of the point on the triangle.
+        pub bary: [f32; 2],
+        /// The triangle.
+        pub triangle: u32,
+        /// The texture of `texture_lookup`.
+        pub texture_index: u32,
+        /// The texture coordinates of `texture_lookup` (any real values: the address modes apply).
+        pub lookup_uv: [f32; 2],
+        /// 1 if `texture_lookup` decodes sRGB texels, else 0.
+        pub srgb: u32,
+        /// Zero.
+        pub pad0: u32,
+        /// The point in scene coordinates (the barycentrics' point), for `triangle_bary`.
+        pub point: [f32; 3],
+        /// Zero; pads the record to 48 bytes.
+        pub pad1: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/surface_oracle.comp writes per item: the surface functions at the
+    /// item's point; vectors in scene coordinates, colours linear RGB.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct SurfaceOracleOutput {
+        /// `surface_at`'s interpolated normal.
+        pub normal: [f32; 3],
+        /// `surface_at`'s tangent handedness, ±1.
+        pub handedness: f32,
+        /// `surface_at`'s tangent.
+        pub tangent: [f32; 3],
+        /// Zero.
+        pub pad0: f32,
+        /// `surface_at`'s texture coordinates of set 0.
+        pub uv0: [f32; 2],
+        /// `surface_at`'s texture coordinates of set 1.
+        pub uv1: [f32; 2],
+        /// `texture_lookup` of the input's texture and coordinates: RGBA.
+        pub texel: [f32; 4],
+        /// `textured_material`'s base colour.
+        pub base_color: [f32; 3],
+        /// `textured_material`'s metallic factor.
+        pub metallic: f32,
+        /// `textured_material`'s emission, radiance.
+        pub emission: [f32; 3],
+        /// `textured_material`'s perceptual roughness.
+        pub roughness: f32,
+        /// `normal_mapped`: the shading normal the normal texture gives, unit.
+        pub normal_mapped: [f32; 3],
+        /// Zero.
+        pub pad1: f32,
+        /// `triangle_bary` of the input's point: barycentrics (b1, b2).
+        pub bary: [f32; 2],
+        /// `texture_coordinates` of the material's base-colour slot: the coordinates its lookup uses.
+        pub base_color_uv: [f32; 2],
+        /// `shading_normal` of the point.
+        pub shading_normal: [f32; 3],
+        /// The roughness of the material `hit_shading` returns.
+        pub hit_roughness: f32,
+        /// The shading normal `hit_shading` returns.
+        pub hit_normal: [f32; 3],
+        /// The metallic factor of the material `hit_shading` returns.
+        pub hit_metallic: f32,
+        /// `texture_tangent_frame` of the material's normal texture: the tangent.
+        pub frame_tangent: [f32; 3],
+        /// `texture_tangent_frame`'s handedness, ±1.
+        pub frame_handedness: f32,
+        /// `surface_at`'s vertex colour (COLOR_0; white without one).
+        pub color: [f32; 3],
+        /// Zero; pads the record to 192 bytes.
+        pub pad2: f32,
+    }
+}

@@ -452,6 +452,10 @@ pub fn records() -> Vec<RecordInfo> {
         GrisOracleOutput::info(),
         SceneOracleInput::info(),
         SceneOracleOutput::info(),
+        AlphaOracleInput::info(),
+        AlphaOracleOutput::info(),
+        SurfaceOracleInput::info(),
+        SurfaceOracleOutput::info(),
     ]
 }
 
