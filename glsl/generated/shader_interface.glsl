@@ -459,4 +459,27 @@ struct SurfaceOracleOutput {
     float pad2;                      // Zero; pads the record to 192 bytes.
 };
 
+struct ShiftOracleParams {
+    float roughness_threshold;       // Perceptual roughness below which a GGX lobe counts as glossy: such a vertex cannot be a reconnection vertex.
+    float distance_threshold;        // Minimum distance in scene units between a reconnection vertex and its predecessor.
+};
+
+struct ShiftOracleTarget {
+    vec3 primary_hit;                // The target domain's primary hit y1 (for an inverse shift, the base path's x1).
+    uint triangle;                   // The triangle of that hit.
+    vec3 camera;                     // The target domain's camera position x0.
+    float pad;                       // Zero; pads the record to 32 bytes.
+};
+
+struct ShiftOracleOutput {
+    PathRecord record;               // The shifted path's record.
+    vec3 contribution;               // The shifted path's contribution f(Y), linear RGB; zero for a failed shift.
+    uint valid;                      // 1 if the shift succeeded, else 0.
+    float jacobian;                  // The shift's Jacobian |dY/dX|.
+    uint vertex_count;               // How many vertices of the shifted path `vertices` holds.
+    uint pad0;                       // Zero.
+    uint pad1;                       // Zero.
+    vec4 vertices[7];                // The shifted path's vertices y1..yk as (position, 0); zero past `vertex_count`.
+};
+
 #endif

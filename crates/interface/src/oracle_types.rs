@@ -5,6 +5,8 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu_record;
+use crate::path_record::PathRecord;
+use crate::shader_interface::MAX_PATH_LENGTH;
 
 gpu_record! {
     struct;
@@ -457,5 +459,60 @@ gpu_record! {
         pub color: [f32; 3],
         /// Zero; pads the record to 192 bytes.
         pub pad2: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// The reconnection criteria given to glsl/oracle/shift_oracle.comp (GLSL `ShiftParams`).
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct ShiftOracleParams {
+        /// Perceptual roughness below which a GGX lobe counts as glossy: such a vertex cannot be a
+        /// reconnection vertex.
+        pub roughness_threshold: f32,
+        /// Minimum distance in scene units between a reconnection vertex and its predecessor.
+        pub distance_threshold: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// The target domain of one shift of glsl/oracle/shift_oracle.comp (the record shifted is
+    /// the item's entry of the `Records` binding); scene coordinates.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct ShiftOracleTarget {
+        /// The target domain's primary hit y1 (for an inverse shift, the base path's x1).
+        pub primary_hit: [f32; 3],
+        /// The triangle of that hit.
+        pub triangle: u32,
+        /// The target domain's camera position x0.
+        pub camera: [f32; 3],
+        /// Zero; pads the record to 32 bytes.
+        pub pad: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/shift_oracle.comp writes per item: the `ShiftResult` of the shift
+    /// under test; scene coordinates.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct ShiftOracleOutput {
+        /// The shifted path's record.
+        pub record: PathRecord,
+        /// The shifted path's contribution f(Y), linear RGB; zero for a failed shift.
+        pub contribution: [f32; 3],
+        /// 1 if the shift succeeded, else 0.
+        pub valid: u32,
+        /// The shift's Jacobian |dY/dX|.
+        pub jacobian: f32,
+        /// How many vertices of the shifted path `vertices` holds.
+        pub vertex_count: u32,
+        /// Zero.
+        pub pad0: u32,
+        /// Zero.
+        pub pad1: u32,
+        /// The shifted path's vertices y1..yk as (position, 0); zero past `vertex_count`.
+        pub vertices: [[f32; 4]; MAX_PATH_LENGTH],
     }
 }

@@ -456,6 +456,9 @@ pub fn records() -> Vec<RecordInfo> {
         AlphaOracleOutput::info(),
         SurfaceOracleInput::info(),
         SurfaceOracleOutput::info(),
+        ShiftOracleParams::info(),
+        ShiftOracleTarget::info(),
+        ShiftOracleOutput::info(),
     ]
 }
 
