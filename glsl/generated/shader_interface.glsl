@@ -482,4 +482,32 @@ struct ShiftOracleOutput {
     vec4 vertices[7];                // The shifted path's vertices y1..yk as (position, 0); zero past `vertex_count`.
 };
 
+struct CandidatesOracleParams {
+    uint max_path_length;            // The longest path, in vertices x1..xk.
+    float roughness_threshold;       // Perceptual roughness below which a GGX lobe counts as glossy (`ShiftParams`).
+    float distance_threshold;        // Minimum distance in scene units between a reconnection vertex and its predecessor.
+    float mis_scale;                 // The candidates' MIS weight 1/N among N paths, which scales their resampling weights.
+};
+
+struct CandidatesOracleInput {
+    vec3 primary_hit;                // The primary hit y1.
+    uint triangle;                   // The triangle of that hit.
+    vec3 camera;                     // The camera position x0.
+    uint seed;                       // The path's random-number key (`path_seed`).
+};
+
+struct CandidatesOracleOutput {
+    PathRecord record;               // The chosen path's record (`reservoir_empty`'s if none was chosen).
+    vec3 expected;                   // The expectation of f(Y) W_Y over the choice, linear RGB.
+    float weight_sum;                // The sum of the candidates' resampling weights.
+    float chosen_target;             // p̂ of the chosen candidate.
+    float weight;                    // W of the result.
+    uint chosen_lost;                // 1 if the chosen path could not be recorded (`chosen_lost`), else 0.
+    uint nonfinite_weights;          // Candidates whose resampling weight was not finite.
+    uint candidates_dropped;         // Candidates dropped (`local_candidates_dropped`).
+    uint pad0;                       // Zero; this and the next two pad the record to 128 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+};
+
 #endif

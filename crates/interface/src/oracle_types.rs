@@ -516,3 +516,66 @@ gpu_record! {
         pub vertices: [[f32; 4]; MAX_PATH_LENGTH],
     }
 }
+
+gpu_record! {
+    struct;
+    /// The parameters of every item of glsl/oracle/candidates_oracle.comp.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct CandidatesOracleParams {
+        /// The longest path, in vertices x1..xk.
+        pub max_path_length: u32,
+        /// Perceptual roughness below which a GGX lobe counts as glossy (`ShiftParams`).
+        pub roughness_threshold: f32,
+        /// Minimum distance in scene units between a reconnection vertex and its predecessor.
+        pub distance_threshold: f32,
+        /// The candidates' MIS weight 1/N among N paths, which scales their resampling weights.
+        pub mis_scale: f32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// One item of glsl/oracle/candidates_oracle.comp: the traced path's start; scene coordinates.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct CandidatesOracleInput {
+        /// The primary hit y1.
+        pub primary_hit: [f32; 3],
+        /// The triangle of that hit.
+        pub triangle: u32,
+        /// The camera position x0.
+        pub camera: [f32; 3],
+        /// The path's random-number key (`path_seed`).
+        pub seed: u32,
+    }
+}
+
+gpu_record! {
+    struct;
+    /// What glsl/oracle/candidates_oracle.comp writes per item: the Resampler after
+    /// `stream_path_candidates` and the pass counters.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+    pub struct CandidatesOracleOutput {
+        /// The chosen path's record (`reservoir_empty`'s if none was chosen).
+        pub record: PathRecord,
+        /// The expectation of f(Y) W_Y over the choice, linear RGB.
+        pub expected: [f32; 3],
+        /// The sum of the candidates' resampling weights.
+        pub weight_sum: f32,
+        /// p̂ of the chosen candidate.
+        pub chosen_target: f32,
+        /// W of the result.
+        pub weight: f32,
+        /// 1 if the chosen path could not be recorded (`chosen_lost`), else 0.
+        pub chosen_lost: u32,
+        /// Candidates whose resampling weight was not finite.
+        pub nonfinite_weights: u32,
+        /// Candidates dropped (`local_candidates_dropped`).
+        pub candidates_dropped: u32,
+        /// Zero; this and the next two pad the record to 128 bytes.
+        pub pad0: u32,
+        /// Zero.
+        pub pad1: u32,
+        /// Zero.
+        pub pad2: u32,
+    }
+}

@@ -459,6 +459,9 @@ pub fn records() -> Vec<RecordInfo> {
         ShiftOracleParams::info(),
         ShiftOracleTarget::info(),
         ShiftOracleOutput::info(),
+        CandidatesOracleParams::info(),
+        CandidatesOracleInput::info(),
+        CandidatesOracleOutput::info(),
     ]
 }
 
