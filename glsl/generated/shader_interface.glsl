@@ -279,4 +279,235 @@ struct ReuseOracleOutput {
     uvec2 pad;                       // Zero; pads the record to 48 bytes.
 };
 
+struct RngOracleOutput {
+    uvec4 pcg4d;                     // `pcg4d(k)`, the hash of all four words.
+    uint path_seed;                  // `path_seed(k.x, k.y, k.z)`: k read as (pixel, sample index, seed).
+    uint pad0;                       // Zero; this and the next two align `uniforms` to 16 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+    vec4 uniforms;                   // `rng_uniform4(k.x, k.y, k.z)`: k read as (seed, vertex, stream); four uniforms in [0, 1).
+};
+
+struct SamplingOracleInput {
+    vec4 u;                          // Four uniforms in [0, 1): xy feed the 2D warps, zw the disk and the scalar functions.
+    vec3 direction;                  // A direction, not necessarily unit: the normal of the frame (normalized by the kernel) and, with |z| + 0.001 for z, the GGX outgoing direction.
+    float alpha;                     // The GGX roughness alpha of `sample_ggx_vndf`.
+};
+
+struct SamplingOracleOutput {
+    vec3 cosine_hemisphere;          // `sample_cosine_hemisphere(u.xy)`, local frame (z up).
+    float cosine_pdf;                // `pdf_cosine_hemisphere(2 u.z - 1)`: the density of a direction of that cosine, per steradian.
+    vec3 uniform_sphere;             // `sample_uniform_sphere(u.xy)`.
+    float power_heuristic;           // `power_heuristic(u.z, u.w)`.
+    vec2 triangle;                   // `sample_triangle(u.xy)`: barycentrics (b1, b2).
+    vec2 concentric_disk;            // `sample_concentric_disk(u.zw)`: a point of the unit disk.
+    vec3 ggx_vndf;                   // `sample_ggx_vndf(wo, alpha, u.xy)`: a visible microfacet normal, local frame, wo the input direction with |z| + 0.001 for z, normalized.
+    float pad0;                      // Zero.
+    vec3 onb_tangent;                // The tangent t of `build_onb(n)`, world space.
+    float pad1;                      // Zero.
+    vec3 onb_bitangent;              // The bitangent b of `build_onb(n)`, world space.
+    float pad2;                      // Zero.
+    vec3 round_trip;                 // `to_world(to_local(u.xyz, t, b, n), t, b, n)`: u.xyz again, within rounding.
+    float pad3;                      // Zero.
+};
+
+struct OracleRay {
+    vec3 origin;                     // The ray's origin.
+    float tmax;                      // The largest ray parameter that counts, in units of |dir| (0: an inactive ray).
+    vec3 dir;                        // The ray's direction, not necessarily unit.
+    float pad;                       // Zero; pads the record to 32 bytes.
+};
+
+struct OracleHit {
+    float t;                         // The ray parameter of the hit, in units of |dir|.
+    uint triangle;                   // The triangle hit (in the scene's BVH leaf order), or `NO_HIT`.
+    vec2 bary;                       // The barycentrics (b1, b2) of the hit, weights of vertices 1 and 2.
+};
+
+struct TracePairOracleInput {
+    OracleRay closest;               // The closest-hit ray.
+    OracleRay shadow;                // The shadow ray, occluded by any hit before its tmax.
+};
+
+struct TracePairOracleOutput {
+    OracleHit hit;                   // The closest ray's hit.
+    uint occluded;                   // 1 if the shadow ray is occluded, else 0.
+    uint pad0;                       // Zero; this and the next two pad the record to 32 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+};
+
+struct BsdfOracleInput {
+    vec3 geometric_normal;           // The geometric normal.
+    float pad0;                      // Zero.
+    vec3 shading_normal;             // The shading normal.
+    float pad1;                      // Zero.
+    vec3 wo;                         // The outgoing direction wo, pointing away from the surface.
+    float pad2;                      // Zero.
+    vec3 wi;                         // The incident direction wi of `bsdf_eval_pdf`, pointing away from the surface.
+    float pad3;                      // Zero.
+    vec4 u;                          // The uniforms of `bsdf_sample` (xy: direction, z: lobe choice, w: reflect/refract choice).
+};
+
+struct BsdfOracleOutput {
+    vec3 f;                          // The BSDF value f(wo, wi), linear RGB, per steradian.
+    float pdf;                       // The solid-angle pdf of sampling wi, per steradian.
+    vec3 sample_wi;                  // The sampled direction, world space.
+    float sample_pdf;                // The sampled direction's solid-angle pdf, per steradian.
+    vec3 sample_weight;              // The sample's weight f |cos| / pdf, linear RGB.
+    uint sample_lobe;                // The lobe sampled (`LOBE_*` bits); `LOBE_NONE` if sampling failed.
+};
+
+struct GrisOracleOffer {
+    vec3 contribution;               // The candidate's contribution f, linear RGB.
+    float target;                    // Its target p̂.
+    float weight;                    // Its resampling weight w; zero or less: the input offers nothing (a failed shift).
+    float u;                         // The uniform in [0, 1) that decides whether it replaces the chosen candidate.
+    uint lost;                       // 1 if recording the candidate fails when it is chosen (`record_chosen`'s loss), else 0.
+    uint pad;                        // Zero; pads the record to 32 bytes.
+};
+
+struct GrisOracleOutput {
+    vec4 mis_weights[3];             // The MIS weight m_i of input i at `[i / 4][i % 4]` for i < n; zero past n.
+    vec3 expected;                   // The expectation of f(Y) W_Y over the choice, linear RGB.
+    int chosen_input;                // The input the chosen candidate came from; -1: none.
+    float weight;                    // W of the result.
+    float confidence;                // M of the result.
+    float pad0;                      // Zero; this and the next pad the record to 80 bytes.
+    float pad1;                      // Zero.
+};
+
+struct SceneOracleInput {
+    OracleRay ray;                   // The ray of `trace_closest` and `trace_occluded`; its origin is also the shading point of `sample_light`, and its direction that point's normal.
+    vec3 light_uniforms;             // The uniforms of `sample_light` (the light choice and the point or direction on it).
+    float pad0;                      // Zero.
+    vec2 image_point;                // The image point of `camera_ray_dir`, in pixels of the frame parameters' image.
+    vec2 pad1;                       // Zero; pads the record to 64 bytes.
+};
+
+struct SceneOracleOutput {
+    OracleHit hit;                   // `trace_closest` of the ray.
+    vec3 offset_origin;              // `offset_ray_origin` of the ray's origin and direction off triangle i mod the triangle count (i the item).
+    uint occluded;                   // 1 if `trace_occluded` found the ray occluded, else 0.
+    vec3 light_dir;                  // The sampled light's direction from the shading point, unit.
+    float light_dist;                // The distance to the sampled point, scene units; infinite for the environment and distant lights.
+    vec3 light_radiance;             // The sampled radiance.
+    float light_pdf;                 // The sample's solid-angle pdf, per steradian (a probability for a punctual light).
+    vec3 camera_dir;                 // `camera_ray_dir` of the image point: camera 0's ray direction, unit.
+    uint light_triangle;             // The sampled emitter (`LightSample::triangle`): a triangle, a punctual light with `PUNCTUAL_LIGHT_BIT` set, or `NO_EMITTER` for the environment.
+    uint punctual_shadowed;          // 1 if the sample is a punctual light and `punctual_occluded` blocks it, else 0.
+    float pdf_again;                 // The sample's pdf recomputed as MIS and the shifts do (`environment_pdf`, `light_select_pmf` or `emitter_pdf`); 0 when the sample's pdf is 0.
+    uvec2 pad;                       // Zero; pads the record to 96 bytes.
+};
+
+struct AlphaOracleInput {
+    vec3 origin;                     // The ray's origin.
+    float shadow_tmax;               // The shadow ray's tmax, in units of |dir| (the closest ray has none).
+    vec3 dir;                        // The ray's direction, unit.
+    uint triangle;                   // The triangle of `material_alpha` and `alpha_keeps`, and of `alpha_hash` with the ray.
+    vec2 bary;                       // The barycentrics (b1, b2) on that triangle.
+    vec2 pad;                        // Zero; pads the record to 48 bytes.
+};
+
+struct AlphaOracleOutput {
+    OracleHit hit;                   // `bvh_traverse`'s closest hit kept by alpha testing.
+    uint any_hit;                    // 1 if `bvh_traverse`'s any-hit query meets a kept hit before the shadow tmax, else 0.
+    uint pair_occluded;              // 1 if `trace_pair`'s shadow ray is occluded, else 0.
+    float hash;                      // `alpha_hash` of the ray and the item's triangle, in [0, 1).
+    float alpha;                     // `material_alpha` at the item's point: the coverage alpha, in [0, 1].
+    OracleHit pair_hit;              // `trace_pair`'s closest hit.
+    uint keeps;                      // 1 if `alpha_keeps` keeps the item's point as a hit of the ray, else 0.
+    uint pad0;                       // Zero; this and the next two pad the record to 64 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+};
+
+struct SurfaceOracleInput {
+    vec2 bary;                       // The barycentrics (b1, b2) of the point on the triangle.
+    uint triangle;                   // The triangle.
+    uint texture_index;              // The texture of `texture_lookup`.
+    vec2 lookup_uv;                  // The texture coordinates of `texture_lookup` (any real values: the address modes apply).
+    uint srgb;                       // 1 if `texture_lookup` decodes sRGB texels, else 0.
+    uint pad0;                       // Zero.
+    vec3 point;                      // The point in scene coordinates (the barycentrics' point), for `triangle_bary`.
+    float pad1;                      // Zero; pads the record to 48 bytes.
+};
+
+struct SurfaceOracleOutput {
+    vec3 normal;                     // `surface_at`'s interpolated normal.
+    float handedness;                // `surface_at`'s tangent handedness, ±1.
+    vec3 tangent;                    // `surface_at`'s tangent.
+    float pad0;                      // Zero.
+    vec2 uv0;                        // `surface_at`'s texture coordinates of set 0.
+    vec2 uv1;                        // `surface_at`'s texture coordinates of set 1.
+    vec4 texel;                      // `texture_lookup` of the input's texture and coordinates: RGBA.
+    vec3 base_color;                 // `textured_material`'s base colour.
+    float metallic;                  // `textured_material`'s metallic factor.
+    vec3 emission;                   // `textured_material`'s emission, radiance.
+    float roughness;                 // `textured_material`'s perceptual roughness.
+    vec3 normal_mapped;              // `normal_mapped`: the shading normal the normal texture gives, unit.
+    float pad1;                      // Zero.
+    vec2 bary;                       // `triangle_bary` of the input's point: barycentrics (b1, b2).
+    vec2 base_color_uv;              // `texture_coordinates` of the material's base-colour slot: the coordinates its lookup uses.
+    vec3 shading_normal;             // `shading_normal` of the point.
+    float hit_roughness;             // The roughness of the material `hit_shading` returns.
+    vec3 hit_normal;                 // The shading normal `hit_shading` returns.
+    float hit_metallic;              // The metallic factor of the material `hit_shading` returns.
+    vec3 frame_tangent;              // `texture_tangent_frame` of the material's normal texture: the tangent.
+    float frame_handedness;          // `texture_tangent_frame`'s handedness, ±1.
+    vec3 color;                      // `surface_at`'s vertex colour (COLOR_0; white without one).
+    float pad2;                      // Zero; pads the record to 192 bytes.
+};
+
+struct ShiftOracleParams {
+    float roughness_threshold;       // Perceptual roughness below which a GGX lobe counts as glossy: such a vertex cannot be a reconnection vertex.
+    float distance_threshold;        // Minimum distance in scene units between a reconnection vertex and its predecessor.
+};
+
+struct ShiftOracleTarget {
+    vec3 primary_hit;                // The target domain's primary hit y1 (for an inverse shift, the base path's x1).
+    uint triangle;                   // The triangle of that hit.
+    vec3 camera;                     // The target domain's camera position x0.
+    float pad;                       // Zero; pads the record to 32 bytes.
+};
+
+struct ShiftOracleOutput {
+    PathRecord record;               // The shifted path's record.
+    vec3 contribution;               // The shifted path's contribution f(Y), linear RGB; zero for a failed shift.
+    uint valid;                      // 1 if the shift succeeded, else 0.
+    float jacobian;                  // The shift's Jacobian |dY/dX|.
+    uint vertex_count;               // How many vertices of the shifted path `vertices` holds.
+    uint pad0;                       // Zero.
+    uint pad1;                       // Zero.
+    vec4 vertices[7];                // The shifted path's vertices y1..yk as (position, 0); zero past `vertex_count`.
+};
+
+struct CandidatesOracleParams {
+    uint max_path_length;            // The longest path, in vertices x1..xk.
+    float roughness_threshold;       // Perceptual roughness below which a GGX lobe counts as glossy (`ShiftParams`).
+    float distance_threshold;        // Minimum distance in scene units between a reconnection vertex and its predecessor.
+    float mis_scale;                 // The candidates' MIS weight 1/N among N paths, which scales their resampling weights.
+};
+
+struct CandidatesOracleInput {
+    vec3 primary_hit;                // The primary hit y1.
+    uint triangle;                   // The triangle of that hit.
+    vec3 camera;                     // The camera position x0.
+    uint seed;                       // The path's random-number key (`path_seed`).
+};
+
+struct CandidatesOracleOutput {
+    PathRecord record;               // The chosen path's record (`reservoir_empty`'s if none was chosen).
+    vec3 expected;                   // The expectation of f(Y) W_Y over the choice, linear RGB.
+    float weight_sum;                // The sum of the candidates' resampling weights.
+    float chosen_target;             // p̂ of the chosen candidate.
+    float weight;                    // W of the result.
+    uint chosen_lost;                // 1 if the chosen path could not be recorded (`chosen_lost`), else 0.
+    uint nonfinite_weights;          // Candidates whose resampling weight was not finite.
+    uint candidates_dropped;         // Candidates dropped (`local_candidates_dropped`).
+    uint pad0;                       // Zero; this and the next two pad the record to 128 bytes.
+    uint pad1;                       // Zero.
+    uint pad2;                       // Zero.
+};
+
 #endif

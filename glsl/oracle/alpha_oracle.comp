@@ -12,27 +12,25 @@ layout(local_size_x = 64) in;
 #include "interface/scene_bindings.glsl"
 #include "shading_core/trace_pair.glsl"
 
-// Per item: (origin, shadow tmax), (direction, -), (triangle bits, b1, b2, -).
-layout(std430, set = 0, binding = 9) readonly buffer Inputs { vec4 inputs[]; };
-layout(std430, set = 0, binding = 10) writeonly buffer Outputs { vec4 outputs[]; };
+layout(std430, set = 0, binding = 9) readonly buffer Inputs { AlphaOracleInput inputs[]; };
+layout(std430, set = 0, binding = 10) writeonly buffer Outputs { AlphaOracleOutput outputs[]; };
 layout(push_constant) uniform Push { uint count; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count) return;
-    vec4 o = inputs[3u * i];
-    vec3 d = inputs[3u * i + 1u].xyz;
-    vec4 a = inputs[3u * i + 2u];
-    uint tri = floatBitsToUint(a.x);
+    vec4 o = vec4(inputs[i].origin, inputs[i].shadow_tmax);
+    vec3 d = inputs[i].dir;
+    vec2 bary = inputs[i].bary;
+    uint tri = inputs[i].triangle;
     Hit h = bvh_traverse(o.xyz, d, 1e30, false);
     bool any = bvh_traverse(o.xyz, d, o.w, true).triangle != NO_HIT;
     Hit ph;
     bool pair_occluded;
     trace_pair(PairRay(o.xyz, d, 1e30), PairRay(o.xyz, d, o.w), ph, pair_occluded);
     uint material = triangles[tri].material;
-    float alpha = material_alpha(material, surface_at(tri, a.yz));
-    outputs[4u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
-    outputs[4u * i + 1u] = vec4(any ? 1.0 : 0.0, pair_occluded ? 1.0 : 0.0, alpha_hash(o.xyz, d, tri), alpha);
-    outputs[4u * i + 2u] = vec4(ph.t, uintBitsToFloat(ph.triangle), ph.bary);
-    outputs[4u * i + 3u] = vec4(alpha_keeps(tri, a.yz, o.xyz, d) ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+    float alpha = material_alpha(material, surface_at(tri, bary));
+    outputs[i] = AlphaOracleOutput(OracleHit(h.t, h.triangle, h.bary), any ? 1u : 0u, pair_occluded ? 1u : 0u,
+                                   alpha_hash(o.xyz, d, tri), alpha, OracleHit(ph.t, ph.triangle, ph.bary),
+                                   alpha_keeps(tri, bary, o.xyz, d) ? 1u : 0u, 0u, 0u, 0u);
 }

@@ -13,14 +13,10 @@ layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Confidences { float case_confidences[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Targets { float case_targets[]; };
-// Per item and input, 2 vec4: (contribution, p̂), (resampling weight w, u, 1 if recording the
-// candidate fails, 0).
-layout(std430, set = 0, binding = 3) readonly buffer Offers { vec4 offers[]; };
-// Per item, 4 vec4: m_0..m_3, m_4..m_7, (m_8, the chosen input or -1, W, M), (expected, 0).
-layout(std430, set = 0, binding = 4) writeonly buffer Outputs { vec4 outputs[]; };
+// Per item and input: the candidate the input offers.
+layout(std430, set = 0, binding = 3) readonly buffer Offers { GrisOracleOffer offers[]; };
+layout(std430, set = 0, binding = 4) writeonly buffer Outputs { GrisOracleOutput outputs[]; };
 layout(push_constant) uniform Push { uint count; };
-
-const uint OUT_STRIDE = 4u;
 
 void main() {
     uint item = gl_GlobalInvocationID.x;
@@ -34,22 +30,19 @@ void main() {
         for (uint l = 0u; l < n; ++l) targets_from[l] = case_targets[MAX_INPUTS * (MAX_INPUTS * item + i) + l];
         m[i] = mis_weight(n, i);
         s.confidence += confidences[i];
-        vec4 a = offers[2u * (MAX_INPUTS * item + i)];
-        float w = offers[2u * (MAX_INPUTS * item + i) + 1u].x;
-        float u = offers[2u * (MAX_INPUTS * item + i) + 1u].y;
+        GrisOracleOffer a = offers[MAX_INPUTS * item + i];
+        float w = a.weight;
+        float u = a.u;
         if (!(w > 0.0)) continue;
         PathRecord y = reservoir_empty().record;
         y.seed = i;
-        y.contribution = a.xyz;
-        resampler_add(s, y, a.w, w, u);
+        y.contribution = a.contribution;
+        resampler_add(s, y, a.target, w, u);
     }
     bool chose = s.weight_sum > 0.0;
     // As record_chosen does when the chosen path cannot be recorded.
-    if (chose && offers[2u * (MAX_INPUTS * item + s.chosen.seed) + 1u].z != 0.0) s.chosen_lost = true;
+    if (chose && offers[MAX_INPUTS * item + s.chosen.seed].lost != 0u) s.chosen_lost = true;
     Reservoir r = resampler_finish(s);
-    uint o = OUT_STRIDE * item;
-    outputs[o] = vec4(m[0], m[1], m[2], m[3]);
-    outputs[o + 1u] = vec4(m[4], m[5], m[6], m[7]);
-    outputs[o + 2u] = vec4(m[8], chose ? float(r.record.seed) : -1.0, r.W, r.M);
-    outputs[o + 3u] = vec4(s.expected, 0.0);
+    vec4 mis_weights[3] = vec4[3](vec4(m[0], m[1], m[2], m[3]), vec4(m[4], m[5], m[6], m[7]), vec4(m[8], 0.0, 0.0, 0.0));
+    outputs[item] = GrisOracleOutput(mis_weights, s.expected, chose ? int(r.record.seed) : -1, r.W, r.M, 0.0, 0.0);
 }

@@ -5,27 +5,34 @@ layout(local_size_x = 64) in;
 
 #include "shading_core/sampling.glsl"
 
-// Per item: u (xy used), params (xyz: direction or normal, w: alpha).
-layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };
-layout(std430, set = 0, binding = 1) writeonly buffer Outputs { vec4 outputs[]; };
-layout(push_constant) uniform Push { uint count; };
+#include "shader_interface.glsl"
 
-const uint OUTPUTS_PER_ITEM = 7u;
+layout(std430, set = 0, binding = 0) readonly buffer Inputs { SamplingOracleInput inputs[]; };
+layout(std430, set = 0, binding = 1) writeonly buffer Outputs { SamplingOracleOutput outputs[]; };
+layout(push_constant) uniform Push { uint count; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count) return;
-    vec4 u = inputs[2u * i];
-    vec4 p = inputs[2u * i + 1u];
-    uint o = OUTPUTS_PER_ITEM * i;
+    vec4 u = inputs[i].u;
+    vec4 p = vec4(inputs[i].direction, inputs[i].alpha);
     vec3 t, b;
     build_onb(normalize(p.xyz), t, b);
-    outputs[o] = vec4(sample_cosine_hemisphere(u.xy), pdf_cosine_hemisphere(u.z * 2.0 - 1.0));
-    outputs[o + 1u] = vec4(sample_uniform_sphere(u.xy), power_heuristic(u.z, u.w));
-    outputs[o + 2u] = vec4(sample_triangle(u.xy), sample_concentric_disk(u.zw));
+    SamplingOracleOutput o;
+    o.cosine_hemisphere = sample_cosine_hemisphere(u.xy);
+    o.cosine_pdf = pdf_cosine_hemisphere(u.z * 2.0 - 1.0);
+    o.uniform_sphere = sample_uniform_sphere(u.xy);
+    o.power_heuristic = power_heuristic(u.z, u.w);
+    o.triangle = sample_triangle(u.xy);
+    o.concentric_disk = sample_concentric_disk(u.zw);
     vec3 wo = normalize(vec3(p.x, p.y, abs(p.z) + 1e-3));
-    outputs[o + 3u] = vec4(sample_ggx_vndf(wo, p.w, u.xy), 0.0);
-    outputs[o + 4u] = vec4(t, 0.0);
-    outputs[o + 5u] = vec4(b, 0.0);
-    outputs[o + 6u] = vec4(to_world(to_local(u.xyz, t, b, normalize(p.xyz)), t, b, normalize(p.xyz)), 0.0);
+    o.ggx_vndf = sample_ggx_vndf(wo, p.w, u.xy);
+    o.onb_tangent = t;
+    o.onb_bitangent = b;
+    o.round_trip = to_world(to_local(u.xyz, t, b, normalize(p.xyz)), t, b, normalize(p.xyz));
+    o.pad0 = 0.0;
+    o.pad1 = 0.0;
+    o.pad2 = 0.0;
+    o.pad3 = 0.0;
+    outputs[i] = o;
 }

@@ -11,18 +11,17 @@ layout(local_size_x = 64) in;
 #include "shading/lights.glsl"
 #include "shading/punctual.glsl"
 
-// Per item: origin (w: tmax), direction, light-sample uniforms (xyz), image point (xy).
-layout(std430, set = 0, binding = 5) readonly buffer Inputs { vec4 inputs[]; };
-layout(std430, set = 0, binding = 6) writeonly buffer Outputs { vec4 outputs[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Inputs { SceneOracleInput inputs[]; };
+layout(std430, set = 0, binding = 6) writeonly buffer Outputs { SceneOracleOutput outputs[]; };
 layout(push_constant) uniform Push { uint count; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count) return;
-    vec4 o = inputs[4u * i];
-    vec3 d = inputs[4u * i + 1u].xyz;
-    vec3 u = inputs[4u * i + 2u].xyz;
-    vec2 px = inputs[4u * i + 3u].xy;
+    vec4 o = vec4(inputs[i].ray.origin, inputs[i].ray.tmax);
+    vec3 d = inputs[i].ray.dir;
+    vec3 u = inputs[i].light_uniforms;
+    vec2 px = inputs[i].image_point;
     Hit h = trace_closest(o.xyz, d, o.w);
     bool occluded = trace_occluded(o.xyz, d, o.w);
     // The ray direction stands in for the shading point's normal.
@@ -38,10 +37,7 @@ void main() {
         else if (row != NO_EMITTER) pdf_again = light_select_pmf(o.xyz, d, row);
         else pdf_again = emitter_pdf(o.xyz, d, ls.triangle, ls.dir, ls.dist);
     }
-    outputs[6u * i + 5u] = vec4(shadowed ? 1.0 : 0.0, pdf_again, 0.0, 0.0);
-    outputs[6u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
-    outputs[6u * i + 1u] = vec4(occluded ? 1.0 : 0.0, offset_ray_origin(o.xyz, d, triangles[offset_triangle]));
-    outputs[6u * i + 2u] = vec4(ls.dir, ls.dist);
-    outputs[6u * i + 3u] = vec4(ls.radiance, ls.pdf);
-    outputs[6u * i + 4u] = vec4(camera_ray_dir(px.x, px.y), uintBitsToFloat(ls.triangle));
+    outputs[i] = SceneOracleOutput(OracleHit(h.t, h.triangle, h.bary), offset_ray_origin(o.xyz, d, triangles[offset_triangle]),
+                                   occluded ? 1u : 0u, ls.dir, ls.dist, ls.radiance, ls.pdf, camera_ray_dir(px.x, px.y),
+                                   ls.triangle, shadowed ? 1u : 0u, pdf_again, uvec2(0u));
 }

@@ -12,40 +12,45 @@ layout(local_size_x = 64) in;
 #include "interface/scene_bindings.glsl"
 #include "scene/hit_surface.glsl"
 
-// Per item: (triangle bits, b1, b2, texture bits), (u, v, srgb, -), (point xyz, -).
-layout(std430, set = 0, binding = 9) readonly buffer Inputs { vec4 inputs[]; };
-layout(std430, set = 0, binding = 10) writeonly buffer Outputs { vec4 outputs[]; };
+layout(std430, set = 0, binding = 9) readonly buffer Inputs { SurfaceOracleInput inputs[]; };
+layout(std430, set = 0, binding = 10) writeonly buffer Outputs { SurfaceOracleOutput outputs[]; };
 layout(push_constant) uniform Push { uint count; };
-
-const uint OUT_ROWS = 12u;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count) return;
-    vec4 a = inputs[3u * i];
-    vec4 b = inputs[3u * i + 1u];
-    vec3 p = inputs[3u * i + 2u].xyz;
-    uint tri = floatBitsToUint(a.x);
-    SurfaceHit s = surface_at(tri, a.yz);
+    SurfaceOracleInput item = inputs[i];
+    vec2 bary = item.bary;
+    vec3 p = item.point;
+    uint tri = item.triangle;
+    SurfaceHit s = surface_at(tri, bary);
     uint material = triangles[tri].material;
     Material m = textured_material(materials[material], material, s);
-    uint o = OUT_ROWS * i;
-    outputs[o] = vec4(s.normal, s.handedness);
-    outputs[o + 1u] = vec4(s.tangent, 0.0);
-    outputs[o + 2u] = vec4(s.uv0, s.uv1);
-    outputs[o + 3u] = texture_lookup(floatBitsToUint(a.w), b.xy, b.z > 0.5);
-    outputs[o + 4u] = vec4(m.base_color, m.metallic);
-    outputs[o + 5u] = vec4(m.emission, m.roughness);
-    outputs[o + 6u] = vec4(normal_mapped(material, s), 0.0);
-    outputs[o + 7u] = vec4(triangle_bary(triangles[tri], p), texture_coordinates(material_textures[material].base_color, s));
+    SurfaceOracleOutput o;
+    o.normal = s.normal;
+    o.handedness = s.handedness;
+    o.tangent = s.tangent;
+    o.uv0 = s.uv0;
+    o.uv1 = s.uv1;
+    o.texel = texture_lookup(item.texture_index, item.lookup_uv, item.srgb != 0u);
+    o.base_color = m.base_color;
+    o.metallic = m.metallic;
+    o.emission = m.emission;
+    o.roughness = m.roughness;
+    o.normal_mapped = normal_mapped(material, s);
+    o.bary = triangle_bary(triangles[tri], p);
+    o.base_color_uv = texture_coordinates(material_textures[material].base_color, s);
     Material hm;
     vec3 ns;
-    hit_shading(tri, a.yz, normalize(cross(triangles[tri].e1, triangles[tri].e2)), hm, ns);
-    outputs[o + 8u] = vec4(shading_normal(tri, a.yz), hm.roughness);
-    outputs[o + 9u] = vec4(ns, hm.metallic);
-    vec3 frame_tangent;
-    float frame_handedness;
-    texture_tangent_frame(material_textures[material].normal, s, frame_tangent, frame_handedness);
-    outputs[o + 10u] = vec4(frame_tangent, frame_handedness);
-    outputs[o + 11u] = vec4(s.color, 0.0);
+    hit_shading(tri, bary, normalize(cross(triangles[tri].e1, triangles[tri].e2)), hm, ns);
+    o.shading_normal = shading_normal(tri, bary);
+    o.hit_roughness = hm.roughness;
+    o.hit_normal = ns;
+    o.hit_metallic = hm.metallic;
+    texture_tangent_frame(material_textures[material].normal, s, o.frame_tangent, o.frame_handedness);
+    o.color = s.color;
+    o.pad0 = 0.0;
+    o.pad1 = 0.0;
+    o.pad2 = 0.0;
+    outputs[i] = o;
 }

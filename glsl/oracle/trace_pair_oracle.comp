@@ -7,19 +7,17 @@ layout(local_size_x = 64) in;
 #include "interface/scene_bindings.glsl"
 #include "shading_core/trace_pair.glsl"
 
-// Per item: closest ray origin (w: tmax), direction, shadow ray origin (w: tmax), direction.
-layout(std430, set = 0, binding = 5) readonly buffer Inputs { vec4 inputs[]; };
-layout(std430, set = 0, binding = 6) writeonly buffer Outputs { vec4 outputs[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Inputs { TracePairOracleInput inputs[]; };
+layout(std430, set = 0, binding = 6) writeonly buffer Outputs { TracePairOracleOutput outputs[]; };
 layout(push_constant) uniform Push { uint count; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count) return;
-    vec4 co = inputs[4u * i];
-    vec4 so = inputs[4u * i + 2u];
+    OracleRay c = inputs[i].closest;
+    OracleRay s = inputs[i].shadow;
     Hit h;
     bool occluded;
-    trace_pair(PairRay(co.xyz, inputs[4u * i + 1u].xyz, co.w), PairRay(so.xyz, inputs[4u * i + 3u].xyz, so.w), h, occluded);
-    outputs[2u * i] = vec4(h.t, uintBitsToFloat(h.triangle), h.bary);
-    outputs[2u * i + 1u] = vec4(occluded ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+    trace_pair(PairRay(c.origin, c.dir, c.tmax), PairRay(s.origin, s.dir, s.tmax), h, occluded);
+    outputs[i] = TracePairOracleOutput(OracleHit(h.t, h.triangle, h.bary), occluded ? 1u : 0u, 0u, 0u, 0u);
 }

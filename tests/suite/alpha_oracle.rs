@@ -4,8 +4,9 @@
 //! `material_alpha`) on random triangles with opaque, MASK (textured and not) and BLEND
 //! (textured and not) materials.
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3};
 use restir_pt::gpu_types::{Material, Triangle, NO_EMITTER};
+use restir_pt::oracle_types::{AlphaOracleInput, AlphaOracleOutput};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
 use restir_pt::shading::alpha::{alpha_hash, alpha_keeps, AlphaScene};
@@ -136,25 +137,32 @@ fn decision_margin(scene: &Scene, alpha: &AlphaScene, o: Vec3, d: Vec3, tmax: f3
     margin
 }
 
-/// `RAYS` random rays from [-extent, extent]^3 as oracle/alpha_oracle.comp takes them (three
-/// rows each), with a random triangle and barycentrics for the per-triangle functions.
-fn alpha_oracle_inputs(scene: &Scene, seed: u64, extent: f32) -> Vec<Vec4> {
+/// `RAYS` random rays from [-extent, extent]^3 as oracle/alpha_oracle.comp takes them, with a
+/// random triangle and barycentrics for the per-triangle functions.
+fn alpha_oracle_inputs(scene: &Scene, seed: u64, extent: f32) -> Vec<AlphaOracleInput> {
     let mut r = TestRng(seed);
-    let mut inputs = Vec::with_capacity(3 * RAYS);
+    let mut inputs = Vec::with_capacity(RAYS);
     for _ in 0..RAYS {
         let o = (Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 2.0 - 1.0) * extent;
-        inputs.push(o.extend(0.5 + 6.0 * r.uniform()));
-        inputs.push(r.unit_vector().extend(0.0));
+        let shadow_tmax = 0.5 + 6.0 * r.uniform();
+        let dir = r.unit_vector();
         let tri = (r.uniform() * scene.triangles.len() as f32) as u32 % scene.triangles.len() as u32;
         let b = restir_pt::shading::sampling::sample_triangle(Vec2::new(r.uniform(), r.uniform()));
-        inputs.push(Vec4::new(f32::from_bits(tri), b.x, b.y, 0.0));
+        inputs.push(AlphaOracleInput {
+            origin: o.to_array(),
+            shadow_tmax,
+            dir: dir.to_array(),
+            triangle: tri,
+            bary: b.to_array(),
+            pad: [0.0; 2],
+        });
     }
     inputs
 }
 
-/// Runs oracle/alpha_oracle.comp over `inputs` (three rows per item), `trace_pair` in its
-/// brute-force form if `brute_force`; four rows per item back.
-fn run_alpha_oracle(scene: &Scene, inputs: &[Vec4], brute_force: bool) -> Vec<Vec4> {
+/// Runs oracle/alpha_oracle.comp over `inputs`, `trace_pair` in its brute-force form if
+/// `brute_force`.
+fn run_alpha_oracle(scene: &Scene, inputs: &[AlphaOracleInput], brute_force: bool) -> Vec<AlphaOracleOutput> {
     let ctx = gpu();
     let scene_gpu = SceneGpu::upload(&ctx, scene).unwrap();
     let defines = scene_gpu.defines();
@@ -166,7 +174,7 @@ fn run_alpha_oracle(scene: &Scene, inputs: &[Vec4], brute_force: bool) -> Vec<Ve
         );
     }
     let extra: &[(&str, &str)] = if brute_force { &[("SCENE_BRUTE_FORCE", "1")] } else { &[] };
-    let out = run_surface_set0_oracle_with(&ctx, &scene_gpu, "oracle/alpha_oracle.comp", extra, inputs, inputs.len() / 3, 4);
+    let out = run_surface_set0_oracle_with(&ctx, &scene_gpu, "oracle/alpha_oracle.comp", extra, inputs);
     assert_clean(&ctx);
     out
 }
@@ -183,17 +191,16 @@ struct OracleCounts {
 
 /// Compares the GLSL results `out` with the Rust twins ray by ray (asserting), `trace_pair` in
 /// its brute-force form if `brute_force`.
-fn compare_alpha_oracle(scene: &Scene, inputs: &[Vec4], out: &[Vec4], brute_force: bool) -> OracleCounts {
+fn compare_alpha_oracle(scene: &Scene, inputs: &[AlphaOracleInput], out: &[AlphaOracleOutput], brute_force: bool) -> OracleCounts {
     let alpha = scene.alpha().expect("the scene has non-opaque materials");
     let mut n = OracleCounts::default();
-    for i in 0..RAYS {
-        let (o, tmax_s, d) = (inputs[3 * i].truncate(), inputs[3 * i].w, inputs[3 * i + 1].truncate());
-        let (tri, bary) = (inputs[3 * i + 2].x.to_bits(), Vec2::new(inputs[3 * i + 2].y, inputs[3 * i + 2].z));
-        let g = &out[4 * i..4 * i + 4];
-        assert_eq!(g[1].z.to_bits(), alpha_hash(o, d, tri).to_bits(), "alpha_hash, item {i}");
+    for (i, (input, g)) in inputs.iter().zip(out).enumerate() {
+        let (o, tmax_s, d) = (Vec3::from_array(input.origin), input.shadow_tmax, Vec3::from_array(input.dir));
+        let (tri, bary) = (input.triangle, Vec2::from_array(input.bary));
+        assert_eq!(g.hash.to_bits(), alpha_hash(o, d, tri).to_bits(), "alpha_hash, item {i}");
         let t = &scene.textures.materials[scene.triangles[tri as usize].material as usize];
         let a = material_alpha(t, &scene.textures, &scene.surface_at(tri, bary));
-        assert!(close(g[1].w, a, 1e-4), "material_alpha, item {i}: GLSL {} vs Rust {a}", g[1].w);
+        assert!(close(g.alpha, a, 1e-4), "material_alpha, item {i}: GLSL {} vs Rust {a}", g.alpha);
         let threshold = if t.alpha_mode == ALPHA_MASK {
             t.alpha_cutoff
         } else {
@@ -201,7 +208,7 @@ fn compare_alpha_oracle(scene: &Scene, inputs: &[Vec4], out: &[Vec4], brute_forc
         };
         if t.alpha_mode == ALPHA_OPAQUE || (a - threshold).abs() > MARGIN {
             let keeps = alpha_keeps(&alpha, &scene.triangles, tri, bary, o, d);
-            assert_eq!(g[3].x == 1.0, keeps, "alpha_keeps, item {i}");
+            assert_eq!(g.keeps == 1, keeps, "alpha_keeps, item {i}");
             n.kept += keeps as usize;
             n.dropped += !keeps as usize;
         }
@@ -212,17 +219,17 @@ fn compare_alpha_oracle(scene: &Scene, inputs: &[Vec4], out: &[Vec4], brute_forc
         let h = bvh_traverse(&scene.nodes, &scene.triangles, Some(&alpha), o, d, 1e30, false);
         let opaque = bvh_traverse(&scene.nodes, &scene.triangles, None, o, d, 1e30, false);
         n.changed += (opaque.triangle != h.triangle) as usize;
-        assert_eq!(g[0].y.to_bits(), h.triangle, "bvh_traverse closest triangle, ray {i}");
-        assert_eq!(g[2].y.to_bits(), h.triangle, "trace_pair closest triangle, ray {i}");
+        assert_eq!(g.hit.triangle, h.triangle, "bvh_traverse closest triangle, ray {i}");
+        assert_eq!(g.pair_hit.triangle, h.triangle, "trace_pair closest triangle, ray {i}");
         if h.triangle != NO_HIT {
-            assert!(close(g[0].x, h.t, 1e-4) && close(g[2].x, h.t, 1e-4), "hit distance, ray {i}");
+            assert!(close(g.hit.t, h.t, 1e-4) && close(g.pair_hit.t, h.t, 1e-4), "hit distance, ray {i}");
             assert!(
-                (Vec2::new(g[0].z, g[0].w) - h.bary).abs().max_element() < 1e-4,
+                (Vec2::from_array(g.hit.bary) - h.bary).abs().max_element() < 1e-4,
                 "barycentrics, ray {i}"
             );
         }
         let any = bvh_traverse(&scene.nodes, &scene.triangles, Some(&alpha), o, d, tmax_s, true).triangle != NO_HIT;
-        assert_eq!(g[1].x == 1.0, any, "bvh_traverse any hit, ray {i}");
+        assert_eq!(g.any_hit == 1, any, "bvh_traverse any hit, ray {i}");
         let shadow = PairRay {
             origin: o,
             dir: d,
@@ -235,7 +242,7 @@ fn compare_alpha_oracle(scene: &Scene, inputs: &[Vec4], out: &[Vec4], brute_forc
             (h.triangle, any),
             "Rust trace_pair against bvh_traverse, ray {i}"
         );
-        assert_eq!(g[1].y == 1.0, occluded, "trace_pair occlusion, ray {i}");
+        assert_eq!(g.pair_occluded == 1, occluded, "trace_pair occlusion, ray {i}");
     }
     n
 }

@@ -4,9 +4,10 @@
 
 use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
+use restir_pt::oracle_types::{BsdfOracleInput, BsdfOracleOutput};
 use restir_pt::shading::bsdf::*;
 
-use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_bsdf_oracle, TestRng};
+use crate::common::{assert_clean, assert_vec3_close, bsdf_input, close, gpu, run_bsdf_oracle, TestRng};
 
 /// Relative agreement of values; GGX at small alpha and grazing angles amplifies ulp differences.
 const TOL: f32 = 1e-3;
@@ -88,23 +89,23 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
     let mut r = TestRng(99);
     let n_items = 1 << 14;
     let mut materials = Vec::with_capacity(n_items);
-    let mut inputs = Vec::with_capacity(5 * n_items);
+    let mut inputs = Vec::with_capacity(n_items);
     for _ in 0..n_items {
         materials.push(random_material(&mut r));
         let ng = r.unit_vector();
-        inputs.extend([
-            ng.extend(0.0),
-            random_shading_normal(&mut r, ng).extend(0.0),
-            r.unit_vector().extend(0.0),
-            r.unit_vector().extend(0.0),
-        ]);
-        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
+        inputs.push(bsdf_input(
+            ng,
+            random_shading_normal(&mut r, ng),
+            r.unit_vector(),
+            r.unit_vector(),
+            Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()),
+        ));
     }
     let out = run_bsdf_oracle(&ctx, &materials, &inputs);
     let mut excluded = 0;
     let mut sampled = 0;
     for i in 0..n_items {
-        match check_bsdf_item(&materials[i], &inputs[5 * i..5 * i + 5], &out[3 * i..3 * i + 3], i) {
+        match check_bsdf_item(&materials[i], &inputs[i], &out[i], i) {
             None => excluded += 1,
             Some(true) => sampled += 1,
             Some(false) => {}
@@ -118,42 +119,47 @@ fn bsdf_eval_pdf_and_bsdf_sample_glsl_matches_rust() {
     assert_clean(&ctx);
 }
 
-/// bsdf_eval_pdf and bsdf_sample of item `i` (inputs ng, ns, wo, wi, u; GLSL outputs `g`)
-/// against their Rust twins. None when the item sits within rounding of a decision and is
-/// excluded, else whether a sample was drawn and compared.
-fn check_bsdf_item(m: &Material, input: &[Vec4], g: &[Vec4], i: usize) -> Option<bool> {
+/// bsdf_eval_pdf and bsdf_sample of item `i` (GLSL outputs `g`) against their Rust twins. None
+/// when the item sits within rounding of a decision and is excluded, else whether a sample was
+/// drawn and compared.
+fn check_bsdf_item(m: &Material, input: &BsdfOracleInput, g: &BsdfOracleOutput, i: usize) -> Option<bool> {
     let (ng, ns, wo, wi, u) = (
-        input[0].truncate(),
-        input[1].truncate(),
-        input[2].truncate(),
-        input[3].truncate(),
-        input[4],
+        Vec3::from_array(input.geometric_normal),
+        Vec3::from_array(input.shading_normal),
+        Vec3::from_array(input.wo),
+        Vec3::from_array(input.wi),
+        Vec4::from_array(input.u),
     );
     if near_side(ng, ns, wi) || near_decision(m, ng, ns, wo, u) {
         return None;
     }
     let (f, pdf) = bsdf_eval_pdf(m, ng, ns, wo, wi);
-    assert_vec3_close(format_args!("bsdf_eval_pdf f item {i} for {m:?}"), g[0].truncate(), f, TOL);
-    assert!(close(g[0].w, pdf, TOL), "bsdf_eval_pdf pdf item {i}: GLSL {} vs Rust {pdf}", g[0].w);
+    assert_vec3_close(format_args!("bsdf_eval_pdf f item {i} for {m:?}"), Vec3::from_array(g.f), f, TOL);
+    assert!(close(g.pdf, pdf, TOL), "bsdf_eval_pdf pdf item {i}: GLSL {} vs Rust {pdf}", g.pdf);
     let s = bsdf_sample(m, ng, ns, wo, u);
     if s.lobe != LOBE_NONE && near_side(ng, ns, s.wi) {
         return None;
     }
-    let lobe = g[2].w.to_bits();
+    let lobe = g.sample_lobe;
     assert_eq!(lobe, s.lobe, "bsdf_sample lobe item {i} for {m:?}");
     if s.lobe == LOBE_NONE {
         return Some(false);
     }
-    assert_vec3_close(format_args!("bsdf_sample wi item {i} for {m:?}"), g[1].truncate(), s.wi, TOL);
+    assert_vec3_close(
+        format_args!("bsdf_sample wi item {i} for {m:?}"),
+        Vec3::from_array(g.sample_wi),
+        s.wi,
+        TOL,
+    );
     assert!(
-        close(g[1].w, s.pdf, TOL),
+        close(g.sample_pdf, s.pdf, TOL),
         "bsdf_sample pdf item {i}: GLSL {} vs Rust {}",
-        g[1].w,
+        g.sample_pdf,
         s.pdf
     );
     assert_vec3_close(
         format_args!("bsdf_sample weight item {i} for {m:?}"),
-        g[2].truncate(),
+        Vec3::from_array(g.sample_weight),
         s.weight,
         TOL,
     );

@@ -3,8 +3,9 @@
 
 use std::sync::Arc;
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3};
 use restir_pt::gpu_types::{NO_EMITTER, PUNCTUAL_LIGHT_BIT};
+use restir_pt::oracle_types::{OracleRay, SceneOracleInput, SceneOracleOutput};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::Scene;
 use restir_pt::shading::bvh::{trace_closest, trace_occluded, NO_HIT};
@@ -85,28 +86,19 @@ fn check_scene_oracle(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, d
     let settings = oracle_settings();
     let params = params_buffer(scene_gpu, &settings);
     let mut r = TestRng(2);
-    let mut inputs = Vec::with_capacity(4 * RAYS);
+    let mut inputs = Vec::with_capacity(RAYS);
     for i in 0..RAYS {
         let o = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
         // Half the rays are shadow-ray-like segments with a finite tmax.
         let tmax = if i % 2 == 0 { 1e30 } else { 0.5 + 6.0 * r.uniform() };
-        inputs.push(o.extend(tmax));
-        inputs.push(r.unit_vector().extend(0.0));
-        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
-        inputs.push(Vec4::new(r.uniform() * 64.0, r.uniform() * 48.0, 0.0, 0.0));
+        let dir = r.unit_vector();
+        let light_uniforms = [r.uniform(), r.uniform(), r.uniform()];
+        let image_point = [r.uniform() * 64.0, r.uniform() * 48.0];
+        inputs.push(scene_input(o, tmax, dir, light_uniforms, image_point));
     }
-    let out: Vec<Vec4> = run_oracle_with_defines(
-        ctx,
-        "oracle/scene_oracle.comp",
-        defines,
-        &scene_gpu.buffers(&params),
-        &[("Inputs", bytemuck::cast_slice(&inputs))],
-        RAYS * 24,
-        RAYS as u32,
-    );
+    let out = run_scene_oracle_kernel(ctx, scene_gpu, &params, defines, &inputs);
     let mut coverage = Coverage::default();
-    for i in 0..RAYS {
-        let (input, g) = (&inputs[4 * i..4 * i + 4], &out[6 * i..6 * i + 6]);
+    for (i, (input, g)) in inputs.iter().zip(&out).enumerate() {
         check_traversal(scene, input, g, i, &mut coverage);
         check_light_and_camera(scene, &settings, input, g, i, &mut coverage);
     }
@@ -132,57 +124,101 @@ fn check_scene_oracle(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, d
     assert_clean(ctx);
 }
 
+/// An item of oracle/scene_oracle.comp: the ray (o, dir) up to `tmax`, light-sample uniforms
+/// and an image point in pixels.
+fn scene_input(o: Vec3, tmax: f32, dir: Vec3, light_uniforms: [f32; 3], image_point: [f32; 2]) -> SceneOracleInput {
+    SceneOracleInput {
+        ray: OracleRay {
+            origin: o.to_array(),
+            tmax,
+            dir: dir.to_array(),
+            pad: 0.0,
+        },
+        light_uniforms,
+        image_point,
+        ..Default::default()
+    }
+}
+
+/// Runs oracle/scene_oracle.comp, compiled with `defines`, over `inputs`.
+fn run_scene_oracle_kernel(
+    ctx: &Arc<Context>,
+    scene_gpu: &SceneGpu,
+    params: &Buffer,
+    defines: &[(&str, &str)],
+    inputs: &[SceneOracleInput],
+) -> Vec<SceneOracleOutput> {
+    run_oracle_with_defines(
+        ctx,
+        "oracle/scene_oracle.comp",
+        defines,
+        &scene_gpu.buffers(params),
+        &[("Inputs", bytemuck::cast_slice(inputs))],
+        inputs.len() * std::mem::size_of::<SceneOracleOutput>() / 4,
+        inputs.len() as u32,
+    )
+}
+
 /// trace_closest, trace_occluded and offset_ray_origin of ray `i` against their Rust twins.
-fn check_traversal(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
-    let (o, d) = (input[0], input[1].truncate());
-    let h = trace_closest(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
+fn check_traversal(scene: &Scene, input: &SceneOracleInput, g: &SceneOracleOutput, i: usize, coverage: &mut Coverage) {
+    let (o, d, tmax) = (Vec3::from_array(input.ray.origin), Vec3::from_array(input.ray.dir), input.ray.tmax);
+    let h = trace_closest(&scene.nodes, &scene.triangles, o, d, tmax);
     assert_eq!(
-        g[0].y.to_bits(),
-        h.triangle,
+        g.hit.triangle, h.triangle,
         "trace_closest triangle, ray {i}: GLSL t {} vs Rust t {}",
-        g[0].x,
-        h.t
+        g.hit.t, h.t
     );
     if h.triangle != NO_HIT {
         coverage.hits += 1;
-        assert!(close(g[0].x, h.t, 1e-4), "trace_closest t, ray {i}");
+        assert!(close(g.hit.t, h.t, 1e-4), "trace_closest t, ray {i}");
         assert!(
-            close(g[0].z, h.bary.x, 1e-4) && close(g[0].w, h.bary.y, 1e-4),
+            close(g.hit.bary[0], h.bary.x, 1e-4) && close(g.hit.bary[1], h.bary.y, 1e-4),
             "trace_closest barycentrics, ray {i}"
         );
     }
-    let occluded = trace_occluded(&scene.nodes, &scene.triangles, o.truncate(), d, o.w);
-    assert_eq!(g[1].x == 1.0, occluded, "trace_occluded, ray {i}");
-    let off = offset_ray_origin(o.truncate(), d, &scene.triangles[i % scene.triangles.len()]);
+    let occluded = trace_occluded(&scene.nodes, &scene.triangles, o, d, tmax);
+    assert_eq!(g.occluded == 1, occluded, "trace_occluded, ray {i}");
+    let off = offset_ray_origin(o, d, &scene.triangles[i % scene.triangles.len()]);
     for k in 0..3 {
-        assert!(close(g[1][k + 1], off[k], 1e-6), "offset_ray_origin, ray {i}");
+        assert!(close(g.offset_origin[k], off[k], 1e-6), "offset_ray_origin, ray {i}");
     }
 }
 
 /// sample_light, the pdf of its sample, camera_ray_dir and punctual_occluded of item `i` against
 /// their Rust twins.
-fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec4], g: &[Vec4], i: usize, coverage: &mut Coverage) {
-    let (o, d, u, px) = (input[0], input[1].truncate(), input[2].truncate(), input[3]);
-    let ls = sample_light(scene, o.truncate(), d, u);
-    let dist_ok = (ls.dist.is_infinite() && g[2].w.is_infinite()) || close(g[2].w, ls.dist, 1e-4);
+fn check_light_and_camera(
+    scene: &Scene,
+    settings: &RenderSettings,
+    input: &SceneOracleInput,
+    g: &SceneOracleOutput,
+    i: usize,
+    coverage: &mut Coverage,
+) {
+    let (o, d) = (Vec3::from_array(input.ray.origin), Vec3::from_array(input.ray.dir));
+    let (u, px) = (Vec3::from_array(input.light_uniforms), Vec2::from_array(input.image_point));
+    let ls = sample_light(scene, o, d, u);
+    let dist_ok = (ls.dist.is_infinite() && g.light_dist.is_infinite()) || close(g.light_dist, ls.dist, 1e-4);
     assert!(
-        dist_ok && (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
+        dist_ok && (Vec3::from_array(g.light_dir) - ls.dir).abs().max_element() < 1e-4,
         "sample_light direction, item {i}: {g:?} vs {ls:?}"
     );
     assert!(
-        (g[3].truncate() - ls.radiance).abs().max_element() < 1e-4 && close(g[3].w, ls.pdf, 1e-3),
+        (Vec3::from_array(g.light_radiance) - ls.radiance).abs().max_element() < 1e-4 && close(g.light_pdf, ls.pdf, 1e-3),
         "sample_light value, item {i}"
     );
     let dir = scene.cameras[0].ray_dir(px.x, px.y, settings.width, settings.height);
-    assert!((g[4].truncate() - dir).abs().max_element() < 1e-5, "camera_ray_dir, item {i}");
-    assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light triangle, item {i}");
+    assert!(
+        (Vec3::from_array(g.camera_dir) - dir).abs().max_element() < 1e-5,
+        "camera_ray_dir, item {i}"
+    );
+    assert_eq!(g.light_triangle, ls.triangle, "sample_light triangle, item {i}");
     // GLSL's own pdf of its sample, recomputed along the light's bit trail, equals the pdf it
     // sampled with (what MIS and the shifts rely on), to float rounding.
     assert!(
-        close(g[5].y, g[3].w, 1e-5),
+        close(g.pdf_again, g.light_pdf, 1e-5),
         "light_select_pmf / emitter_pdf vs sample pdf, item {i}: {} vs {}",
-        g[5].y,
-        g[3].w
+        g.pdf_again,
+        g.light_pdf
     );
     if ls.pdf > 0.0 {
         coverage.light_samples += 1;
@@ -191,25 +227,20 @@ fn check_light_and_camera(scene: &Scene, settings: &RenderSettings, input: &[Vec
         let again = if ls.triangle == NO_EMITTER {
             environment_pdf(scene, ls.dir)
         } else if is_punctual_light(ls.triangle) {
-            light_select_pmf(
-                scene,
-                o.truncate(),
-                d,
-                punctual_emitter_row(scene, ls.triangle & !PUNCTUAL_LIGHT_BIT),
-            )
+            light_select_pmf(scene, o, d, punctual_emitter_row(scene, ls.triangle & !PUNCTUAL_LIGHT_BIT))
         } else {
-            emitter_pdf(scene, o.truncate(), d, ls.triangle, ls.dir, ls.dist)
+            emitter_pdf(scene, o, d, ls.triangle, ls.dir, ls.dist)
         };
         assert!(
-            close(g[5].y, again, 1e-3),
+            close(g.pdf_again, again, 1e-3),
             "environment_pdf / light_select_pmf / emitter_pdf, item {i}: GLSL {} vs Rust {again}",
-            g[5].y
+            g.pdf_again
         );
     }
     if is_punctual_light(ls.triangle) {
         coverage.punctual_samples += 1;
-        let shadowed = punctual_occluded(scene, o.truncate(), d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
-        assert_eq!(g[5].x == 1.0, shadowed, "punctual_occluded, item {i}");
+        let shadowed = punctual_occluded(scene, o, d, (i % scene.triangles.len()) as u32, ls.dir, ls.dist);
+        assert_eq!(g.punctual_shadowed == 1, shadowed, "punctual_occluded, item {i}");
         coverage.punctual_shadowed += shadowed as usize;
     }
 }
@@ -271,44 +302,36 @@ fn environment_map_light_sampling_matches(degrees: f32) {
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
     let params = params_buffer(&scene_gpu, &oracle_settings());
     let mut r = TestRng(6);
-    let mut inputs = Vec::with_capacity(4 * RAYS);
+    let mut inputs = Vec::with_capacity(RAYS);
     for _ in 0..RAYS {
-        inputs.push((Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0).extend(1e30));
-        inputs.push(r.unit_vector().extend(0.0));
-        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), 0.0));
-        inputs.push(Vec4::ZERO);
+        let o = Vec3::new(r.uniform(), r.uniform(), r.uniform()) * 10.0 - 5.0;
+        let dir = r.unit_vector();
+        let light_uniforms = [r.uniform(), r.uniform(), r.uniform()];
+        inputs.push(scene_input(o, 1e30, dir, light_uniforms, [0.0; 2]));
     }
     let defines = scene_gpu.defines();
     assert!(defines.contains(&("SCENE_ENV_MAP", "1")));
-    let out: Vec<Vec4> = run_oracle_with_defines(
-        &ctx,
-        "oracle/scene_oracle.comp",
-        &defines,
-        &scene_gpu.buffers(&params),
-        &[("Inputs", bytemuck::cast_slice(&inputs))],
-        RAYS * 24,
-        RAYS as u32,
-    );
+    let out = run_scene_oracle_kernel(&ctx, &scene_gpu, &params, &defines, &inputs);
     let (mut env_samples, mut near_edges) = (0, 0);
-    for i in 0..RAYS {
-        let (o, u) = (inputs[4 * i].truncate(), inputs[4 * i + 2].truncate());
-        let ls = sample_light(&scene, o, inputs[4 * i + 1].truncate(), u);
-        let g = &out[6 * i..6 * i + 6];
-        assert_eq!(g[4].w.to_bits(), ls.triangle, "sample_light choice, item {i}");
+    for (i, (input, g)) in inputs.iter().zip(&out).enumerate() {
+        let (o, u) = (Vec3::from_array(input.ray.origin), Vec3::from_array(input.light_uniforms));
+        let ls = sample_light(&scene, o, Vec3::from_array(input.ray.dir), u);
+        assert_eq!(g.light_triangle, ls.triangle, "sample_light choice, item {i}");
+        let light_dir = Vec3::from_array(g.light_dir);
         assert!(
-            (g[2].truncate() - ls.dir).abs().max_element() < 1e-4,
+            (light_dir - ls.dir).abs().max_element() < 1e-4,
             "sample_light direction, item {i}: {} vs {}",
-            g[2].truncate(),
+            light_dir,
             ls.dir
         );
         if ls.triangle == NO_EMITTER && ls.dist.is_infinite() {
             env_samples += 1;
-            if !check_environment_sample(&scene, &ls, g[3], i) {
+            if !check_environment_sample(&scene, &ls, g, i) {
                 near_edges += 1;
                 continue;
             }
         }
-        assert!(close(g[3].w, ls.pdf, 1e-3), "sample_light pdf, item {i}");
+        assert!(close(g.light_pdf, ls.pdf, 1e-3), "sample_light pdf, item {i}");
     }
     assert!(env_samples > RAYS / 4, "only {env_samples} environment samples");
     assert!(
@@ -318,9 +341,9 @@ fn environment_map_light_sampling_matches(degrees: f32) {
     assert_clean(&ctx);
 }
 
-/// environment_radiance and environment_pdf of environment sample `i` (GLSL output `g3`)
+/// environment_radiance and environment_pdf of environment sample `i` (GLSL output `g`)
 /// against their Rust twins; false (nothing compared) when the direction sits on a texel edge.
-fn check_environment_sample(scene: &Scene, ls: &LightSample, g3: Vec4, i: usize) -> bool {
+fn check_environment_sample(scene: &Scene, ls: &LightSample, g: &SceneOracleOutput, i: usize) -> bool {
     use restir_pt::shading::lights::{environment_pdf, environment_radiance};
     // The map is piecewise constant: radiance and pdf must agree unless the direction
     // sits within 0.005 texels of a texel edge, where llvmpipe's atan/acos and Rust's
@@ -331,11 +354,15 @@ fn check_environment_sample(scene: &Scene, ls: &LightSample, g3: Vec4, i: usize)
     if (uv - uv.round()).abs().min_element() < 5e-3 {
         return false;
     }
-    assert_eq!(g3.truncate(), environment_radiance(scene, ls.dir), "environment radiance, item {i}");
+    assert_eq!(
+        Vec3::from_array(g.light_radiance),
+        environment_radiance(scene, ls.dir),
+        "environment radiance, item {i}"
+    );
     assert!(
-        close(g3.w, environment_pdf(scene, ls.dir), 1e-4),
+        close(g.light_pdf, environment_pdf(scene, ls.dir), 1e-4),
         "environment pdf, item {i}: {} vs {}",
-        g3.w,
+        g.light_pdf,
         ls.pdf
     );
     true

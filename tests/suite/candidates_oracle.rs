@@ -4,7 +4,8 @@
 //! into a fresh Resampler on both sides, with and without Russian roulette; the chosen record,
 //! the weight sum, W, the expectation and the pass counters compared.
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
+use restir_pt::oracle_types::{CandidatesOracleInput, CandidatesOracleOutput, CandidatesOracleParams};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::Scene;
 use restir_pt::shading::bvh::NO_HIT;
@@ -25,33 +26,28 @@ fn close(a: f32, b: f32, tol: f32) -> bool {
     (a - b).abs() <= tol * a.abs().max(b.abs()).max(1e-30)
 }
 
-/// Whether the GLSL output `g` (8 vec4) agrees with the Rust result: the chosen record (header
+/// Whether the GLSL output `g` agrees with the Rust result: the chosen record (header
 /// exactly; cached terms, contribution within 1e-3), the weight sum, W and the expectation
 /// within 1e-3 relative, the counters exactly. The largest relative difference of the sums.
-fn agrees(g: &[Vec4], record: &PathRecord, weight_sum: f32, w: f32, lost: bool, expected: Vec3) -> Option<f32> {
-    let header = [
-        g[0].x.to_bits(),
-        g[0].y.to_bits(),
-        g[0].z.to_bits(),
-        g[0].w.to_bits(),
-        g[4].w.to_bits(),
-    ];
+fn agrees(g: &CandidatesOracleOutput, record: &PathRecord, weight_sum: f32, w: f32, lost: bool, expected: Vec3) -> Option<f32> {
+    let gr = &g.record;
+    let header = [gr.seed, gr.info, gr.lobes, gr.rc_triangle, gr.rc_next_triangle];
     let r = record;
-    if header != [r.seed, r.info, r.lobes, r.rc_triangle, r.rc_next_triangle] || (g[5].w != 0.0) != lost {
+    if header != [r.seed, r.info, r.lobes, r.rc_triangle, r.rc_next_triangle] || (g.chosen_lost != 0) != lost {
         return None;
     }
     let floats = [
-        (g[1].w, r.rc_pdf),
-        (g[2].w, r.rc_geometry),
-        (g[3].w, r.rc_pdf_after),
-        (g[4].x, r.contribution[0]),
-        (g[4].y, r.contribution[1]),
-        (g[4].z, r.contribution[2]),
-        (g[5].x, weight_sum),
-        (g[5].z, w),
-        (g[6].x, expected.x),
-        (g[6].y, expected.y),
-        (g[6].z, expected.z),
+        (gr.rc_pdf, r.rc_pdf),
+        (gr.rc_geometry, r.rc_geometry),
+        (gr.rc_pdf_after, r.rc_pdf_after),
+        (gr.contribution[0], r.contribution[0]),
+        (gr.contribution[1], r.contribution[1]),
+        (gr.contribution[2], r.contribution[2]),
+        (g.weight_sum, weight_sum),
+        (g.weight, w),
+        (g.expected[0], expected.x),
+        (g.expected[1], expected.y),
+        (g.expected[2], expected.z),
     ];
     let worst = floats
         .iter()
@@ -78,8 +74,7 @@ fn stream_path_candidates_glsl_matches_rust() {
         let out = run_candidates_oracle(&ctx, &scene, &items, &params, scale, russian_roulette);
         let camera = scene.cameras[0].position;
         let (mut chosen, mut differ, mut beyond_1e4, mut dropped, mut cut) = (0, 0, 0, 0, 0);
-        for (i, (y1, seed)) in items.iter().enumerate() {
-            let g = &out[8 * i..8 * i + 8];
+        for (i, ((y1, seed), g)) in items.iter().zip(&out).enumerate() {
             let mut s = resampler_begin();
             let counts = stream_path_candidates(
                 &scene,
@@ -99,13 +94,15 @@ fn stream_path_candidates_glsl_matches_rust() {
                 stream_path_candidates(&scene, &mut without, camera, *y1, *seed, MAX_PATH_LENGTH, &params, scale, false);
                 cut += (without.weight_sum != s.weight_sum) as usize;
             }
-            // Float fields only: the record's uint fields travel as float bits.
+            let gr = &g.record;
+            let floats = [gr.rc_pos, gr.rc_next, gr.suffix, gr.contribution, g.expected];
+            let scalars = [gr.rc_pdf, gr.rc_geometry, gr.rc_pdf_after, g.weight_sum, g.chosen_target, g.weight];
             assert!(
-                g[1..4].iter().chain(&g[5..]).all(|v| !v.is_nan()) && !g[4].truncate().is_nan(),
+                floats.iter().flatten().chain(&scalars).all(|x| !x.is_nan()),
                 "{name} item {i}: NaN in the GLSL output {g:?}"
             );
             assert_eq!(
-                (g[7].x as u32, g[7].y as u32),
+                (g.nonfinite_weights, g.candidates_dropped),
                 (counts.nonfinite_weights, counts.candidates_dropped),
                 "{name} item {i}: counters"
             );
@@ -160,7 +157,7 @@ fn primary_hits(scene: &Scene) -> Vec<(Vertex, u32)> {
     items
 }
 
-/// Runs oracle/candidates_oracle.comp over `items`: eight vec4s of results per item.
+/// Runs oracle/candidates_oracle.comp over `items`.
 fn run_candidates_oracle(
     ctx: &std::sync::Arc<restir_pt::vk::Context>,
     scene: &Scene,
@@ -168,7 +165,7 @@ fn run_candidates_oracle(
     params: &ShiftParams,
     scale: f32,
     russian_roulette: bool,
-) -> Vec<Vec4> {
+) -> Vec<CandidatesOracleOutput> {
     let camera = scene.cameras[0].position;
     let scene_gpu = SceneGpu::upload(ctx, scene).unwrap();
     let frame = Buffer::new(
@@ -183,15 +180,20 @@ fn run_candidates_oracle(
         ..Default::default()
     };
     frame.write(&[settings.frame_params(scene_gpu.info())]).unwrap();
-    let kernel_params = [
-        MAX_PATH_LENGTH as u32,
-        params.roughness_threshold.to_bits(),
-        params.distance_threshold.to_bits(),
-        scale.to_bits(),
-    ];
-    let inputs: Vec<Vec4> = items
+    let kernel_params = CandidatesOracleParams {
+        max_path_length: MAX_PATH_LENGTH as u32,
+        roughness_threshold: params.roughness_threshold,
+        distance_threshold: params.distance_threshold,
+        mis_scale: scale,
+    };
+    let inputs: Vec<CandidatesOracleInput> = items
         .iter()
-        .flat_map(|(y1, seed)| [y1.pos.extend(f32::from_bits(y1.triangle)), camera.extend(f32::from_bits(*seed))])
+        .map(|(y1, seed)| CandidatesOracleInput {
+            primary_hit: y1.pos.to_array(),
+            triangle: y1.triangle,
+            camera: camera.to_array(),
+            seed: *seed,
+        })
         .collect();
     crate::common::run_scene_oracle(
         ctx,
@@ -200,10 +202,10 @@ fn run_candidates_oracle(
         "oracle/candidates_oracle.comp",
         &[],
         &[
-            ("Params", bytemuck::cast_slice(&kernel_params)),
+            ("Params", bytemuck::bytes_of(&kernel_params)),
             ("Items", bytemuck::cast_slice(&inputs)),
         ],
-        ITEMS * 8 * 4,
+        ITEMS * std::mem::size_of::<CandidatesOracleOutput>() / 4,
         ITEMS as u32,
     )
 }

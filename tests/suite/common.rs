@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use restir_pt::oracle_types::{BsdfOracleInput, BsdfOracleOutput};
 use restir_pt::render::SceneGpu;
 use restir_pt::vk::{BindingSlot, BoundBuffer, Buffer, Context, ContextOptions, Kernel};
 
@@ -87,11 +88,26 @@ pub fn run_scene_oracle<T: bytemuck::Pod>(
     run_built_oracle(ctx, build, &scene_gpu.buffers(frame), inputs, output_words, count)
 }
 
-/// Runs oracle/bsdf_oracle.comp (`bsdf_eval_pdf` and `bsdf_sample`): `inputs` holds 5 vec4s per
-/// material (geometric normal, shading normal, wo, wi, u); 3 vec4s come back per material
-/// ((f, pdf), (sampled wi, pdf), (weight, lobe bits)).
-pub fn run_bsdf_oracle(ctx: &Arc<Context>, materials: &[restir_pt::gpu_types::Material], inputs: &[glam::Vec4]) -> Vec<glam::Vec4> {
-    assert_eq!(inputs.len(), 5 * materials.len(), "5 input rows per material");
+/// The input of oracle/bsdf_oracle.comp for normals `ng` (geometric) and `ns` (shading),
+/// directions `wo` and `wi` and `bsdf_sample`'s uniforms `u`.
+pub fn bsdf_input(ng: glam::Vec3, ns: glam::Vec3, wo: glam::Vec3, wi: glam::Vec3, u: glam::Vec4) -> BsdfOracleInput {
+    BsdfOracleInput {
+        geometric_normal: ng.to_array(),
+        shading_normal: ns.to_array(),
+        wo: wo.to_array(),
+        wi: wi.to_array(),
+        u: u.to_array(),
+        ..Default::default()
+    }
+}
+
+/// Runs oracle/bsdf_oracle.comp (`bsdf_eval_pdf` and `bsdf_sample`) on one input per material.
+pub fn run_bsdf_oracle(
+    ctx: &Arc<Context>,
+    materials: &[restir_pt::gpu_types::Material],
+    inputs: &[BsdfOracleInput],
+) -> Vec<BsdfOracleOutput> {
+    assert_eq!(inputs.len(), materials.len(), "one input per material");
     run_oracle(
         ctx,
         "oracle/bsdf_oracle.comp",
@@ -100,37 +116,34 @@ pub fn run_bsdf_oracle(ctx: &Arc<Context>, materials: &[restir_pt::gpu_types::Ma
             ("Materials", bytemuck::cast_slice(materials)),
             ("Inputs", bytemuck::cast_slice(inputs)),
         ],
-        materials.len() * 12,
+        materials.len() * std::mem::size_of::<BsdfOracleOutput>() / 4,
         materials.len() as u32,
     )
 }
 
 /// Runs an oracle kernel that binds everything in set 0: the scene at 0-4 (default frame
 /// parameters), its surface attributes and textures at 5-8 (SURFACE_SET 0, SURFACE_BINDING 5 in
-/// the kernel), `Inputs` at 9 and `Outputs` at 10; the push constant is the item count.
-/// `rows_per_item` vec4s come back per item.
-pub fn run_surface_set0_oracle(
+/// the kernel), `Inputs` at 9 (one `I` per item) and `Outputs` at 10 (one `O` per item, which
+/// come back); the push constant is the item count.
+pub fn run_surface_set0_oracle<I: bytemuck::Pod, O: bytemuck::Pod>(
     ctx: &Arc<Context>,
     scene_gpu: &SceneGpu,
     kernel: &str,
-    inputs: &[glam::Vec4],
-    items: usize,
-    rows_per_item: usize,
-) -> Vec<glam::Vec4> {
-    run_surface_set0_oracle_with(ctx, scene_gpu, kernel, &[], inputs, items, rows_per_item)
+    inputs: &[I],
+) -> Vec<O> {
+    run_surface_set0_oracle_with(ctx, scene_gpu, kernel, &[], inputs)
 }
 
 /// [`run_surface_set0_oracle`] with `extra` defines after the scene's (e.g. SCENE_BRUTE_FORCE,
 /// which the path tracer adds for small scenes).
-pub fn run_surface_set0_oracle_with(
+pub fn run_surface_set0_oracle_with<I: bytemuck::Pod, O: bytemuck::Pod>(
     ctx: &Arc<Context>,
     scene_gpu: &SceneGpu,
     kernel: &str,
     extra: &[(&'static str, &'static str)],
-    inputs: &[glam::Vec4],
-    items: usize,
-    rows_per_item: usize,
-) -> Vec<glam::Vec4> {
+    inputs: &[I],
+) -> Vec<O> {
+    let items = inputs.len();
     use restir_pt::gpu_types::FrameParams;
     use restir_pt::shader_interface::SurfaceBinding;
     use restir_pt::vk::{Binding, BindingFamilyExt, BufferUsage};
@@ -138,7 +151,7 @@ pub fn run_surface_set0_oracle_with(
     let params = Buffer::new(ctx, "params", std::mem::size_of::<FrameParams>() as u64, BufferUsage::Params).unwrap();
     params.write(&[FrameParams::default()]).unwrap();
     let input = Buffer::from_slice(ctx, "inputs", inputs).unwrap();
-    let output = Buffer::new(ctx, "outputs", (items * rows_per_item * 16) as u64, BufferUsage::Storage).unwrap();
+    let output = Buffer::new(ctx, "outputs", (items * std::mem::size_of::<O>()) as u64, BufferUsage::Storage).unwrap();
     output.fill(NAN_FILL).unwrap();
     let mut buffers = scene_gpu.buffers(&params);
     buffers.extend(
@@ -157,7 +170,7 @@ pub fn run_surface_set0_oracle_with(
     let k = Kernel::new(ctx, kernel, &defines, &layout, 4).unwrap();
     k.bind(&buffers).unwrap();
     k.run_1d(items as u32, 64, bytemuck::bytes_of(&(items as u32))).unwrap();
-    bytemuck::cast_slice(&output.read::<u32>(items * rows_per_item * 4).unwrap()).to_vec()
+    output.read::<O>(items).unwrap()
 }
 
 /// Runs the oracle kernel `build` makes from the layout of `leading`, `inputs` and `Outputs`.

@@ -9,7 +9,7 @@ use restir_pt::gpu_types::Material;
 use restir_pt::metrics::{mean, standard_error};
 use restir_pt::shading::bsdf::{bsdf_sample, index_matched, DELTA_ALPHA, LOBE_TRANSMISSION};
 
-use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
+use crate::common::{assert_clean, bsdf_input, gpu, run_bsdf_oracle, TestRng};
 
 pub const IORS: [f32; 9] = [1.0, 1.0 + 1e-6, 1.0 - 1e-6, 1.0001, 1.01, 1.33, 1.5, 2.4, 1.0 / 1.5];
 pub const ROUGHNESSES: [f32; 5] = [0.0, 0.01, 0.1, 0.5, 1.0];
@@ -117,8 +117,8 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
     for case in &cases {
         for _ in 0..SAMPLES {
             materials.push(glass(case.ior, case.roughness));
-            inputs.extend([Vec4::Z, Vec4::Z, case.wo.extend(0.0), Vec4::Z]);
-            inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
+            let u = Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform());
+            inputs.push(bsdf_input(Vec3::Z, Vec3::Z, case.wo, Vec3::Z, u));
         }
     }
     let out = run_bsdf_oracle(&ctx, &materials, &inputs);
@@ -127,9 +127,9 @@ fn dielectric_furnace_sweep_over_ior_and_roughness_glsl_and_rust() {
         let what = format!("IOR {}, roughness {}, cos_o {}", case.ior, case.roughness, case.wo.z);
         let (mut gpu_e, mut cpu_e) = (Vec::with_capacity(SAMPLES), Vec::with_capacity(SAMPLES));
         for k in c * SAMPLES..(c + 1) * SAMPLES {
-            let weight = out[3 * k + 2];
-            gpu_e.push(energy(weight.truncate(), weight.w.to_bits(), case.ior, case.wo.z));
-            let s = bsdf_sample(&materials[k], Vec3::Z, Vec3::Z, case.wo, inputs[5 * k + 4]);
+            let g = &out[k];
+            gpu_e.push(energy(Vec3::from_array(g.sample_weight), g.sample_lobe, case.ior, case.wo.z));
+            let s = bsdf_sample(&materials[k], Vec3::Z, Vec3::Z, case.wo, Vec4::from_array(inputs[k].u));
             cpu_e.push(energy(s.weight, s.lobe, case.ior, case.wo.z));
         }
         let gpu_mean = check(&format!("GLSL, {what}"), case, &gpu_e);

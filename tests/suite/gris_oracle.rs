@@ -5,7 +5,8 @@
 //! confidence weights and p̂_{<-l}(y_i) with failed shifts (zeros) and six decades of range, and
 //! offered candidates with zero weights and lost choices, as the reuse passes see them.
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
+use restir_pt::oracle_types::{GrisOracleOffer, GrisOracleOutput};
 use restir_pt::shading::gris::{mis_weight, resampler_begin, resampler_finish, resampler_offer, Domains, Input, Mis};
 
 use crate::common::{close, gpu, mis_mode, run_oracle_with_defines, TestRng};
@@ -14,24 +15,13 @@ use crate::common::{close, gpu, mis_mode, run_oracle_with_defines, TestRng};
 const MAX_INPUTS: usize = 9;
 const CASES: usize = 4096;
 
-/// One candidate offered to the resampler.
-#[derive(Clone, Copy, Default)]
-struct Offer {
-    contribution: Vec3,
-    target: f32,
-    weight: f32,
-    u: f32,
-    /// Recording the candidate fails if it is chosen (record_chosen's loss).
-    lost: bool,
-}
-
 /// One resampling: n inputs, their confidences c_l, the row p̂_{<-l}(y_i) of every input i's
 /// shifted sample, and the candidates the inputs offer.
 struct Case {
     n: usize,
     confidences: [f32; MAX_INPUTS],
     targets: [[f32; MAX_INPUTS]; MAX_INPUTS],
-    offers: [Offer; MAX_INPUTS],
+    offers: [GrisOracleOffer; MAX_INPUTS],
 }
 
 /// 10^e for e uniform in [-3, 3].
@@ -48,7 +38,7 @@ fn recorded_cases(seed: u64) -> Vec<Case> {
                 n,
                 confidences: [0.0; MAX_INPUTS],
                 targets: [[0.0; MAX_INPUTS]; MAX_INPUTS],
-                offers: [Offer::default(); MAX_INPUTS],
+                offers: [GrisOracleOffer::default(); MAX_INPUTS],
             };
             for l in 0..n {
                 // Reservoir confidences are whole candidate counts, capped at 20.
@@ -65,12 +55,13 @@ fn recorded_cases(seed: u64) -> Vec<Case> {
             for offer in case.offers.iter_mut().take(n) {
                 let target = log_uniform(&mut r);
                 let colour = Vec3::new(r.uniform(), r.uniform(), r.uniform()) + 0.01;
-                *offer = Offer {
-                    contribution: colour * target / restir_pt::metrics::luminance(colour),
+                *offer = GrisOracleOffer {
+                    contribution: (colour * target / restir_pt::metrics::luminance(colour)).to_array(),
                     target,
                     weight: if r.uniform() < 0.2 { 0.0 } else { log_uniform(&mut r) },
                     u: r.uniform(),
-                    lost: r.uniform() < 0.05,
+                    lost: (r.uniform() < 0.05) as u32,
+                    pad: 0,
                 };
             }
             case
@@ -93,17 +84,13 @@ impl Domains<usize> for Recorded<'_> {
     }
 }
 
-/// The GLSL kernel's outputs for every case: 4 vec4 each.
-fn run_glsl(cases: &[Case], mis: Mis) -> Vec<Vec4> {
+/// The GLSL kernel's outputs for every case.
+fn run_glsl(cases: &[Case], mis: Mis) -> Vec<GrisOracleOutput> {
     let ctx = gpu();
     let counts: Vec<u32> = cases.iter().map(|c| c.n as u32).collect();
     let confidences: Vec<f32> = cases.iter().flat_map(|c| c.confidences).collect();
     let targets: Vec<f32> = cases.iter().flat_map(|c| c.targets.into_iter().flatten()).collect();
-    let offers: Vec<Vec4> = cases
-        .iter()
-        .flat_map(|c| c.offers)
-        .flat_map(|o| [o.contribution.extend(o.target), Vec4::new(o.weight, o.u, o.lost as u32 as f32, 0.0)])
-        .collect();
+    let offers: Vec<GrisOracleOffer> = cases.iter().flat_map(|c| c.offers).collect();
     let mode = mis_mode(mis);
     let out = run_oracle_with_defines(
         &ctx,
@@ -116,7 +103,7 @@ fn run_glsl(cases: &[Case], mis: Mis) -> Vec<Vec4> {
             ("Targets", bytemuck::cast_slice(&targets)),
             ("Offers", bytemuck::cast_slice(&offers)),
         ],
-        cases.len() * 16,
+        cases.len() * std::mem::size_of::<GrisOracleOutput>() / 4,
         cases.len() as u32,
     );
     crate::common::assert_clean(&ctx);
@@ -129,9 +116,8 @@ fn check_mis_weight(mis: Mis) {
     let cases = recorded_cases(2024 + mis as u64);
     let out = run_glsl(&cases, mis);
     let mut positive = 0;
-    for (k, case) in cases.iter().enumerate() {
-        let g = &out[4 * k..4 * k + 4];
-        let gpu_weights = [g[0].x, g[0].y, g[0].z, g[0].w, g[1].x, g[1].y, g[1].z, g[1].w, g[2].x];
+    for (k, (case, g)) in cases.iter().zip(&out).enumerate() {
+        let gpu_weights: Vec<f32> = g.mis_weights.iter().flatten().copied().collect();
         let inputs: Vec<Input<usize>> = (0..case.n)
             .map(|i| Input {
                 sample: i,
@@ -173,8 +159,7 @@ fn gris_resampler_glsl_matches_rust() {
     let cases = recorded_cases(77);
     let out = run_glsl(&cases, Mis::GeneralizedBalance);
     let (mut ties, mut chosen, mut lost) = (0, 0, 0);
-    for (k, case) in cases.iter().enumerate() {
-        let g = &out[4 * k..4 * k + 4];
+    for (k, (case, g)) in cases.iter().zip(&out).enumerate() {
         let mut s = resampler_begin::<usize>();
         let mut tie = false;
         for (i, o) in case.offers.iter().enumerate().take(case.n) {
@@ -185,15 +170,15 @@ fn gris_resampler_glsl_matches_rust() {
             }
             let sum = s.weight_sum + o.weight;
             tie |= (o.u * sum - o.weight).abs() <= 1e-5 * o.weight;
-            if resampler_offer(&mut s, o.contribution, o.target, o.weight, o.u) {
+            if resampler_offer(&mut s, Vec3::from_array(o.contribution), o.target, o.weight, o.u) {
                 s.chosen = Some(i);
             }
         }
         if let Some(i) = s.chosen {
-            s.chosen_lost = case.offers[i].lost;
+            s.chosen_lost = case.offers[i].lost != 0;
         }
         let (sample, w, m) = resampler_finish(&s);
-        let gpu_chosen = (g[2].y >= 0.0).then_some(g[2].y as usize);
+        let gpu_chosen = (g.chosen_input >= 0).then_some(g.chosen_input as usize);
         if gpu_chosen != sample {
             assert!(tie, "case {k}: GLSL chose {gpu_chosen:?}, Rust {sample:?}");
             ties += 1;
@@ -202,11 +187,16 @@ fn gris_resampler_glsl_matches_rust() {
         chosen += sample.is_some() as usize;
         lost += s.chosen_lost as usize;
         let rel = |a: f32, b: f32| (a - b).abs() <= 1e-5 * a.abs().max(b.abs());
-        assert!(rel(g[2].z, w) || g[2].z == w, "case {k}: W GLSL {} vs Rust {w}", g[2].z);
-        assert_eq!(g[2].w, m, "case {k}: M");
+        assert!(rel(g.weight, w) || g.weight == w, "case {k}: W GLSL {} vs Rust {w}", g.weight);
+        assert_eq!(g.confidence, m, "case {k}: M");
         for c in 0..3 {
-            let (a, b) = (g[3][c], s.expected[c]);
-            assert!(rel(a, b) || a == b, "case {k}: expected GLSL {} vs Rust {}", g[3], s.expected);
+            let (a, b) = (g.expected[c], s.expected[c]);
+            assert!(
+                rel(a, b) || a == b,
+                "case {k}: expected GLSL {:?} vs Rust {}",
+                g.expected,
+                s.expected
+            );
         }
     }
     eprintln!("resampler: {chosen} choices compared ({lost} lost), {ties} ties excluded of {CASES}");

@@ -1,6 +1,7 @@
 //! GLSL glsl/shading_core/rng.glsl against crates/shading-core/src/rng.rs: pcg4d, path_seed and rng_uniform4 must agree bit for bit.
 
 use glam::UVec4;
+use restir_pt::oracle_types::RngOracleOutput;
 use restir_pt::shading::rng::{path_seed, pcg4d, rng_uniform4};
 
 use crate::common::{assert_clean, gpu, run_oracle, TestRng};
@@ -16,20 +17,19 @@ fn rng_pcg4d_path_seed_rng_uniform4_glsl_matches_rust_bit_exact() {
     // Edge keys: zeros and all-ones exercise the wrap-around arithmetic.
     keys[0] = UVec4::ZERO;
     keys[1] = UVec4::MAX;
-    let out: Vec<UVec4> = run_oracle(
+    let out: Vec<RngOracleOutput> = run_oracle(
         &ctx,
         "oracle/rng_oracle.comp",
         &[],
         &[("Inputs", bytemuck::cast_slice(&keys))],
-        n * 12,
+        n * std::mem::size_of::<RngOracleOutput>() / 4,
         n as u32,
     );
-    for (i, k) in keys.iter().enumerate() {
-        assert_eq!(out[3 * i], pcg4d(*k), "pcg4d({k})");
-        assert_eq!(out[3 * i + 1].x, path_seed(k.x, k.y, k.z), "path_seed({k})");
+    for (k, g) in keys.iter().zip(&out) {
+        assert_eq!(UVec4::from_array(g.pcg4d), pcg4d(*k), "pcg4d({k})");
+        assert_eq!(g.path_seed, path_seed(k.x, k.y, k.z), "path_seed({k})");
         let u = rng_uniform4(k.x, k.y, k.z);
-        let bits = UVec4::new(u.x.to_bits(), u.y.to_bits(), u.z.to_bits(), u.w.to_bits());
-        assert_eq!(out[3 * i + 2], bits, "rng_uniform4({k})");
+        assert_eq!(g.uniforms.map(f32::to_bits), u.to_array().map(f32::to_bits), "rng_uniform4({k})");
     }
     assert_clean(&ctx);
 }

@@ -1,6 +1,7 @@
 //! GLSL glsl/shading_core/sampling.glsl against crates/shading-core/src/sampling.rs on random uniforms and directions.
 
 use glam::{Vec2, Vec3, Vec4};
+use restir_pt::oracle_types::{SamplingOracleInput, SamplingOracleOutput};
 use restir_pt::shading::sampling::*;
 
 use crate::common::{assert_clean, assert_vec3_close, close, gpu, run_oracle, TestRng};
@@ -13,66 +14,75 @@ fn sampling_glsl_matches_rust() {
     let ctx = gpu();
     let mut r = TestRng(21);
     let n = 1 << 14;
-    let mut inputs = Vec::with_capacity(2 * n);
-    for _ in 0..n {
-        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
-        let alpha = 10f32.powf(-3.0 + 3.0 * r.uniform());
-        inputs.push(r.unit_vector().extend(alpha));
-    }
-    let out: Vec<Vec4> = run_oracle(
+    let inputs: Vec<SamplingOracleInput> = (0..n)
+        .map(|_| {
+            let u = [r.uniform(), r.uniform(), r.uniform(), r.uniform()];
+            let alpha = 10f32.powf(-3.0 + 3.0 * r.uniform());
+            SamplingOracleInput {
+                u,
+                direction: r.unit_vector().to_array(),
+                alpha,
+            }
+        })
+        .collect();
+    let out: Vec<SamplingOracleOutput> = run_oracle(
         &ctx,
         "oracle/sampling_oracle.comp",
         &[],
         &[("Inputs", bytemuck::cast_slice(&inputs))],
-        n * 7 * 4,
+        n * std::mem::size_of::<SamplingOracleOutput>() / 4,
         n as u32,
     );
-    for i in 0..n {
-        let (u, p) = (inputs[2 * i], inputs[2 * i + 1]);
-        let o = &out[7 * i..7 * i + 7];
+    for (i, (input, o)) in inputs.iter().zip(&out).enumerate() {
+        let (u, p) = (Vec4::from_array(input.u), Vec3::from_array(input.direction).extend(input.alpha));
         let n_dir = p.truncate().normalize();
         let (t, b) = build_onb(n_dir);
         assert_vec3_close(
             format_args!("sample_cosine_hemisphere item {i}"),
-            o[0].truncate(),
+            Vec3::from_array(o.cosine_hemisphere),
             sample_cosine_hemisphere(Vec2::new(u.x, u.y)),
             TOL,
         );
         assert!(
-            close(o[0].w, pdf_cosine_hemisphere(u.z * 2.0 - 1.0), TOL),
+            close(o.cosine_pdf, pdf_cosine_hemisphere(u.z * 2.0 - 1.0), TOL),
             "pdf_cosine_hemisphere item {i}"
         );
         assert_vec3_close(
             format_args!("sample_uniform_sphere item {i}"),
-            o[1].truncate(),
+            Vec3::from_array(o.uniform_sphere),
             sample_uniform_sphere(Vec2::new(u.x, u.y)),
             TOL,
         );
-        assert!(close(o[1].w, power_heuristic(u.z, u.w), TOL), "power_heuristic item {i}");
+        assert!(close(o.power_heuristic, power_heuristic(u.z, u.w), TOL), "power_heuristic item {i}");
         let tri = sample_triangle(Vec2::new(u.x, u.y));
         let disk = sample_concentric_disk(Vec2::new(u.z, u.w));
         assert_vec3_close(
             format_args!("sample_triangle item {i}"),
-            Vec3::new(o[2].x, o[2].y, 0.0),
+            Vec2::from_array(o.triangle).extend(0.0),
             tri.extend(0.0),
             TOL,
         );
         assert_vec3_close(
             format_args!("sample_concentric_disk item {i}"),
-            Vec3::new(o[2].z, o[2].w, 0.0),
+            Vec2::from_array(o.concentric_disk).extend(0.0),
             disk.extend(0.0),
             TOL,
         );
         let wo = Vec3::new(p.x, p.y, p.z.abs() + 1e-3).normalize();
         assert_vec3_close(
             format_args!("sample_ggx_vndf item {i}"),
-            o[3].truncate(),
+            Vec3::from_array(o.ggx_vndf),
             sample_ggx_vndf(wo, p.w, Vec2::new(u.x, u.y)),
             1e-4,
         );
-        assert_vec3_close(format_args!("build_onb t item {i}"), o[4].truncate(), t, TOL);
-        assert_vec3_close(format_args!("build_onb b item {i}"), o[5].truncate(), b, TOL);
-        assert_vec3_close(format_args!("to_local/to_world item {i}"), o[6].truncate(), u.truncate(), TOL);
+        assert_vec3_close(format_args!("build_onb t item {i}"), Vec3::from_array(o.onb_tangent), t, TOL);
+        assert_vec3_close(format_args!("build_onb b item {i}"), Vec3::from_array(o.onb_bitangent), b, TOL);
+        assert_vec3_close(
+            format_args!("to_local/to_world item {i}"),
+            Vec3::from_array(o.round_trip),
+            u.truncate(),
+            TOL,
+        );
     }
     assert_clean(&ctx);
 }

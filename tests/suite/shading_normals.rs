@@ -9,7 +9,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::{bsdf_eval_pdf, sides_agree};
 
-use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
+use crate::common::{assert_clean, bsdf_input, gpu, run_bsdf_oracle, TestRng};
 
 /// The tilt the shading normal encodes: 25° about the x axis from the geometric normal +z.
 fn tilted_normal() -> Vec3 {
@@ -44,18 +44,23 @@ fn shading_normal_tilted_plane_matches_closed_form_glsl_and_rust() {
     let (mut materials, mut inputs) = (Vec::new(), Vec::new());
     for i in 0..4096 {
         materials.push(if i % 2 == 0 { lambert } else { plastic });
-        inputs.extend([Vec4::Z, ns.extend(0.0), r.unit_vector().extend(0.0), r.unit_vector().extend(0.0)]);
-        inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
+        inputs.push(bsdf_input(
+            Vec3::Z,
+            ns,
+            r.unit_vector(),
+            r.unit_vector(),
+            Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()),
+        ));
     }
     let out = run_bsdf_oracle(&ctx, &materials, &inputs);
     let (mut lit, mut rejected) = (0, 0);
     for (i, m) in materials.iter().enumerate() {
-        let (wo, wi) = (inputs[5 * i + 2].truncate(), inputs[5 * i + 3].truncate());
+        let (wo, wi) = (Vec3::from_array(inputs[i].wo), Vec3::from_array(inputs[i].wi));
         let near_plane = [Vec3::Z, ns].iter().any(|n| wo.dot(*n).abs() < 1e-3 || wi.dot(*n).abs() < 1e-3);
         if near_plane {
             continue;
         }
-        let gpu_f = out[3 * i].truncate();
+        let gpu_f = Vec3::from_array(out[i].f);
         let (cpu_f, _) = bsdf_eval_pdf(m, Vec3::Z, ns, wo, wi);
         let agree = sides_agree(Vec3::Z, ns, wo) && sides_agree(Vec3::Z, ns, wi);
         let expected = if !agree {

@@ -3,7 +3,8 @@
 //! (inverse_reconnection, inverse_random_replay, inverse_hybrid) on the paths the Rust forward
 //! shifts made, carried back to the base's primary hit, as the reuse passes' MIS weights use them.
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
+use restir_pt::oracle_types::{ShiftOracleOutput, ShiftOracleParams, ShiftOracleTarget};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::Scene;
 use restir_pt::shading::path_record::PathRecord;
@@ -67,8 +68,8 @@ fn jobs(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, camera:
         .collect()
 }
 
-/// The GLSL function's outputs for every job: 13 vec4 each (see glsl/oracle/shift_oracle.comp).
-fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, jobs: &[Job], camera: Vec3) -> Vec<Vec4> {
+/// The GLSL function's outputs for every job.
+fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, jobs: &[Job], camera: Vec3) -> Vec<ShiftOracleOutput> {
     let ctx = crate::common::gpu();
     let scene_gpu = SceneGpu::upload(&ctx, scene).unwrap();
     let frame = Buffer::new(
@@ -85,29 +86,37 @@ fn run_glsl(kind: Kind, inverted: bool, scene: &Scene, params: &ShiftParams, job
             Kind::RandomReplay => 1,
             Kind::Hybrid => 2,
         };
-    let shift_params = [0, params.roughness_threshold.to_bits(), params.distance_threshold.to_bits(), 0];
-    let mut out = Vec::with_capacity(jobs.len() * 13);
+    let shift_params = ShiftOracleParams {
+        roughness_threshold: params.roughness_threshold,
+        distance_threshold: params.distance_threshold,
+    };
+    let mut out = Vec::with_capacity(jobs.len());
     // Dispatches of a few thousand shifts each: on a loaded machine one dispatch of 10^4 whole
     // paths can outlast the fence timeout (120 s). Every chunk after the first finds its
     // kernel in the shader cache.
     for chunk in jobs.chunks(2500) {
         let records: Vec<PathRecord> = chunk.iter().map(|j| j.record).collect();
-        let targets: Vec<Vec4> = chunk
+        let targets: Vec<ShiftOracleTarget> = chunk
             .iter()
-            .flat_map(|j| [j.v1.pos.extend(f32::from_bits(j.v1.triangle)), camera.extend(0.0)])
+            .map(|j| ShiftOracleTarget {
+                primary_hit: j.v1.pos.to_array(),
+                triangle: j.v1.triangle,
+                camera: camera.to_array(),
+                pad: 0.0,
+            })
             .collect();
-        out.extend(crate::common::run_scene_oracle::<Vec4>(
+        out.extend(crate::common::run_scene_oracle::<ShiftOracleOutput>(
             &ctx,
             &scene_gpu,
             &frame,
             "oracle/shift_oracle.comp",
             &[("ORACLE_SHIFT", &function.to_string())],
             &[
-                ("Params", bytemuck::cast_slice(&shift_params)),
+                ("Params", bytemuck::bytes_of(&shift_params)),
                 ("Records", bytemuck::cast_slice(&records)),
                 ("Targets", bytemuck::cast_slice(&targets)),
             ],
-            chunk.len() * 13 * 4,
+            chunk.len() * std::mem::size_of::<ShiftOracleOutput>() / 4,
             chunk.len() as u32,
         ));
     }
@@ -134,17 +143,23 @@ struct Tally {
 const GRAZING_END_COSINE: f32 = 1e-3;
 
 /// One job's GLSL output `g` against the Rust twin's result.
-fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32, tally: &mut Tally) {
+fn check_one(what: &str, kind: Kind, g: &ShiftOracleOutput, rust: &ShiftResult, extent: f32, tally: &mut Tally) {
+    let contribution = Vec3::from_array(g.contribution);
     if !rust.valid {
         assert!(
-            g[0].y == 0.0 && g[5].truncate() == Vec3::ZERO,
+            g.jacobian == 0.0 && contribution == Vec3::ZERO,
             "{what}: a failed GLSL shift carries a value"
         );
         return;
     }
-    // Float fields only: the record's uint fields travel as float bits.
-    let floats = [g[0].truncate(), g[2].truncate(), g[3].truncate(), g[4].truncate(), g[5].truncate()];
-    let scalars = [g[2].w, g[3].w, g[4].w];
+    let gr = &g.record;
+    let floats = [
+        Vec3::from_array(gr.rc_pos),
+        Vec3::from_array(gr.rc_next),
+        Vec3::from_array(gr.suffix),
+        contribution,
+    ];
+    let scalars = [g.jacobian, gr.rc_pdf, gr.rc_geometry, gr.rc_pdf_after];
     assert!(
         floats.iter().all(|v| !v.is_nan()) && scalars.iter().all(|x| !x.is_nan()),
         "{what}: NaN in the GLSL output {g:?}"
@@ -152,29 +167,23 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
     tally.compared += 1;
     let r = &rust.record;
     assert_eq!(
-        [
-            g[1].x.to_bits(),
-            g[1].y.to_bits(),
-            g[1].z.to_bits(),
-            g[1].w.to_bits(),
-            g[5].w.to_bits()
-        ],
+        [gr.seed, gr.info, gr.lobes, gr.rc_triangle, gr.rc_next_triangle],
         [r.seed, r.info, r.lobes, r.rc_triangle, r.rc_next_triangle],
         "{what}: record header"
     );
     assert!(
-        close(g[0].y, rust.jacobian, 1e-4),
+        close(g.jacobian, rust.jacobian, 1e-4),
         "{what}: jacobian GLSL {} vs Rust {}",
-        g[0].y,
+        g.jacobian,
         rust.jacobian
     );
     // The record's cached terms (single pdfs and cosines, not the ratios the Jacobian uses) of a
     // path replayed over several bounces carry the bounces' rounding; at grazing angles that
     // reaches 1e-4.
     for (field, a, b) in [
-        ("rc_pdf", g[2].w, r.rc_pdf),
-        ("rc_geometry", g[3].w, r.rc_geometry),
-        ("rc_pdf_after", g[4].w, r.rc_pdf_after),
+        ("rc_pdf", gr.rc_pdf, r.rc_pdf),
+        ("rc_geometry", gr.rc_geometry, r.rc_geometry),
+        ("rc_pdf_after", gr.rc_pdf_after, r.rc_pdf_after),
     ] {
         assert!(close(a, b, 1e-3), "{what}: {field} GLSL {a} vs Rust {b}");
     }
@@ -190,7 +199,7 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
     tally.grazing += grazing as usize;
     let scale = rust.contribution.max_element();
     let worst = (0..3)
-        .map(|c| (g[5][c] - rust.contribution[c]).abs() / scale)
+        .map(|c| (contribution[c] - rust.contribution[c]).abs() / scale)
         .fold(0.0f32, f32::max);
     // Replay regenerates whole paths on two different math libraries. Where an NEE end sees its
     // light nearly edge-on, f(X) is proportional to that cosine and inherits the rounding of the
@@ -199,14 +208,13 @@ fn check_one(what: &str, kind: Kind, g: &[Vec4], rust: &ShiftResult, extent: f32
     let bound = if kind == Kind::RandomReplay { 1e-3 } else { 1e-4 };
     assert!(
         grazing || worst <= bound,
-        "{what}: contribution GLSL {} vs Rust {} ({worst:e})",
-        g[5],
+        "{what}: contribution GLSL {contribution} vs Rust {} ({worst:e})",
         rust.contribution
     );
     tally.beyond_1e4 += (!grazing && worst > 1e-4) as usize;
-    assert_eq!(g[0].z as usize, rust.vertices.len(), "{what}: vertex count");
+    assert_eq!(g.vertex_count as usize, rust.vertices.len(), "{what}: vertex count");
     for (v, rv) in rust.vertices.iter().enumerate() {
-        let gv = g[6 + v].truncate();
+        let gv = glam::Vec4::from_array(g.vertices[v]).truncate();
         assert!(
             (gv - rv.pos).length() <= 1e-4 * extent,
             "{what}: vertex {v} GLSL {gv} vs Rust {}",
@@ -232,9 +240,9 @@ fn check_glsl_matches_rust(kind: Kind, inverted: bool) {
         let mut tally = Tally::default();
         for (i, job) in jobs.iter().enumerate() {
             let what = format!("{name} {function} {kind:?} case {i}");
-            let g = &out[13 * i..13 * i + 13];
+            let g = &out[i];
             let rust = apply(kind, inverted, &scene, &params, job, camera);
-            let gpu_valid = g[0].x == 1.0;
+            let gpu_valid = g.valid == 1;
             if gpu_valid != rust.valid {
                 assert!(
                     near_threshold(kind, inverted, &scene, &params, job, camera, rust.valid),

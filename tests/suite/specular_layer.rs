@@ -10,7 +10,7 @@ use glam::{Vec3, Vec4};
 use restir_pt::gpu_types::Material;
 use restir_pt::shading::bsdf::{bsdf_eval_pdf, bsdf_sample, specular_layer_fresnel, DELTA_ALPHA, LOBE_NONE};
 
-use crate::common::{assert_clean, gpu, run_bsdf_oracle, TestRng};
+use crate::common::{assert_clean, bsdf_input, gpu, run_bsdf_oracle, TestRng};
 use crate::fixtures::statistics::chi_square_critical_1pct;
 
 fn plastic(roughness: f32, ior: f32, specular: f32, specular_color: Vec3) -> Material {
@@ -73,8 +73,8 @@ fn specular_layer_furnace_never_gains_energy_glsl_and_rust() {
             cases.push((m, wo));
             for _ in 0..SAMPLES {
                 materials.push(m);
-                inputs.extend([Vec4::Z, Vec4::Z, wo.extend(0.0), Vec4::Z]);
-                inputs.push(Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform()));
+                let u = Vec4::new(r.uniform(), r.uniform(), r.uniform(), r.uniform());
+                inputs.push(bsdf_input(Vec3::Z, Vec3::Z, wo, Vec3::Z, u));
             }
         }
     }
@@ -87,8 +87,8 @@ fn specular_layer_furnace_never_gains_energy_glsl_and_rust() {
         );
         let (mut gpu_sum, mut cpu_sum) = (Vec3::ZERO, Vec3::ZERO);
         for k in c * SAMPLES..(c + 1) * SAMPLES {
-            let gpu_w = out[3 * k + 2].truncate();
-            let s = bsdf_sample(m, Vec3::Z, Vec3::Z, *wo, inputs[5 * k + 4]);
+            let gpu_w = Vec3::from_array(out[k].sample_weight);
+            let s = bsdf_sample(m, Vec3::Z, Vec3::Z, *wo, Vec4::from_array(inputs[k].u));
             for (who, w) in [("GLSL", gpu_w), ("Rust", s.weight)] {
                 assert!(
                     w.is_finite() && w.min_element() >= 0.0 && w.max_element() <= 1.0 + 1e-4,

@@ -21,6 +21,7 @@ use std::time::{Duration, Instant};
 
 use glam::UVec4;
 use restir_pt::error::GpuError;
+use restir_pt::oracle_types::RngOracleOutput;
 use restir_pt::render::{PathTracer, RenderSettings, Restir, RestirSettings, SceneGpu};
 use restir_pt::scene::{load_scene, Scene};
 use restir_pt::shading::rng::pcg4d;
@@ -88,11 +89,14 @@ fn rng_keys() -> Vec<UVec4> {
     (0..256u32).map(|i| UVec4::new(i, i * 7 + 1, i ^ 0x5bd1, 3)).collect()
 }
 
-/// The RNG oracle's keys in a buffer, and an output buffer for three `uvec4` per key.
+/// Bytes of the RNG oracle's output per key.
+const RNG_OUTPUT_SIZE: u64 = std::mem::size_of::<RngOracleOutput>() as u64;
+
+/// The RNG oracle's keys in a buffer, and an output buffer for one `RngOracleOutput` per key.
 fn rng_buffers(ctx: &Arc<Context>) -> (Vec<UVec4>, Buffer, Buffer) {
     let keys = rng_keys();
     let input = Buffer::from_slice(ctx, "Inputs", &keys).unwrap();
-    let output = Buffer::new(ctx, "Outputs", keys.len() as u64 * 48, BufferUsage::Storage).unwrap();
+    let output = Buffer::new(ctx, "Outputs", keys.len() as u64 * RNG_OUTPUT_SIZE, BufferUsage::Storage).unwrap();
     (keys, input, output)
 }
 
@@ -117,7 +121,7 @@ fn stress_submission_past_the_fence_timeout_is_leaked_not_freed() {
         // Host-visible buffers: writing them submits nothing that could overrun first.
         let input = Buffer::new(&fast, "Inputs", keys.len() as u64 * 16, BufferUsage::Params).unwrap();
         input.write(&keys).unwrap();
-        let output = Buffer::new(&fast, "Outputs", keys.len() as u64 * 48, BufferUsage::Params).unwrap();
+        let output = Buffer::new(&fast, "Outputs", keys.len() as u64 * RNG_OUTPUT_SIZE, BufferUsage::Params).unwrap();
         let layout = [BindingSlot::storage(0, "Inputs"), BindingSlot::storage(1, "Outputs")];
         let kernel = Kernel::new(&fast, "oracle/rng_oracle.comp", &[], &layout, 4).unwrap();
         kernel.bind(&[layout[0].to(&input), layout[1].to(&output)]).unwrap();
@@ -167,9 +171,9 @@ fn kernel_churn(kernels: u32, validated: bool) {
         if let Some(ms) = timer.read_ms(1).unwrap() {
             assert!(ms[0].is_finite() && ms[0] >= 0.0, "timestamp {ms:?}");
         }
-        let out = output.read::<UVec4>(3 * keys.len()).unwrap();
-        for (i, k) in keys.iter().enumerate() {
-            assert_eq!(out[3 * i], pcg4d(*k), "pcg4d({k})");
+        let out = output.read::<RngOracleOutput>(keys.len()).unwrap();
+        for (k, g) in keys.iter().zip(&out) {
+            assert_eq!(UVec4::from_array(g.pcg4d), pcg4d(*k), "pcg4d({k})");
         }
     }
     assert_clean(&ctx);

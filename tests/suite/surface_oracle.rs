@@ -8,6 +8,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 use restir_pt::gpu_types::{Material, Triangle, MATERIAL_ALPHA_EMISSION, MATERIAL_BLEND_EMISSION, NO_EMITTER};
+use restir_pt::oracle_types::{SurfaceOracleInput, SurfaceOracleOutput};
 use restir_pt::render::SceneGpu;
 use restir_pt::scene::{Camera, Scene, SceneParts};
 use restir_pt::shading::surface::{pack_vertex_color, surface_at, triangle_bary, SurfaceHit, TriangleSurface};
@@ -23,8 +24,6 @@ const TEXTURES: usize = 9;
 const MATERIALS: usize = 7;
 /// Relative agreement; sRGB decoding goes through llvmpipe's pow.
 const TOL: f32 = 2e-4;
-/// vec4 outputs per item (OUT_ROWS in surface_oracle.comp).
-const ROWS: usize = 12;
 
 fn random_textures(r: &mut TestRng) -> SceneTextures {
     let mut t = SceneTextures::default();
@@ -192,8 +191,8 @@ fn compare_surfaces(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene)
     let inputs = random_hits(scene);
     let out = run_surface_oracle(ctx, &scene_gpu, &inputs);
     let (mut skipped, mut compared) = (0, 0);
-    for i in 0..ITEMS {
-        if check_item(scene, &inputs[3 * i..3 * i + 3], &out[ROWS * i..ROWS * i + ROWS], i) {
+    for (i, (input, g)) in inputs.iter().zip(&out).enumerate() {
+        if check_item(scene, input, g, i) {
             compared += 1;
         } else {
             skipped += 1;
@@ -204,52 +203,57 @@ fn compare_surfaces(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene: &Scene)
     assert_clean(ctx);
 }
 
-/// Three vec4s per item, as surface_oracle.comp reads them: (triangle bits, barycentrics,
-/// texture bits), (lookup uv, sRGB flag, 0), (hit point, 0).
-fn random_hits(scene: &Scene) -> Vec<Vec4> {
+/// `ITEMS` random points on the scene's triangles, each with a random texture lookup.
+fn random_hits(scene: &Scene) -> Vec<SurfaceOracleInput> {
     let textures = scene.textures.headers.len();
     let mut r = TestRng(11);
-    let mut inputs: Vec<Vec4> = Vec::with_capacity(3 * ITEMS);
+    let mut inputs = Vec::with_capacity(ITEMS);
     for _ in 0..ITEMS {
         let tri = (r.uniform() * scene.triangles.len() as f32) as u32 % scene.triangles.len() as u32;
         let b = restir_pt::shading::sampling::sample_triangle(Vec2::new(r.uniform(), r.uniform()));
         let texture = (r.uniform() * textures as f32) as u32 % textures as u32;
         let t = &scene.triangles[tri as usize];
         let p = Vec3::from(t.v0) + b.x * Vec3::from(t.e1) + b.y * Vec3::from(t.e2);
-        inputs.push(Vec4::new(f32::from_bits(tri), b.x, b.y, f32::from_bits(texture)));
-        inputs.push(Vec4::new(
-            10.0 * r.uniform() - 5.0,
-            10.0 * r.uniform() - 5.0,
-            (r.uniform() < 0.5) as u32 as f32,
-            0.0,
-        ));
-        inputs.push(p.extend(0.0));
+        let lookup_uv = [10.0 * r.uniform() - 5.0, 10.0 * r.uniform() - 5.0];
+        inputs.push(SurfaceOracleInput {
+            bary: b.to_array(),
+            triangle: tri,
+            texture_index: texture,
+            lookup_uv,
+            srgb: (r.uniform() < 0.5) as u32,
+            point: p.to_array(),
+            ..Default::default()
+        });
     }
     inputs
 }
 
-/// Dispatches surface_oracle.comp over `inputs`; `ROWS` vec4s of results per item.
-fn run_surface_oracle(ctx: &std::sync::Arc<restir_pt::vk::Context>, scene_gpu: &SceneGpu, inputs: &[Vec4]) -> Vec<Vec4> {
+/// Dispatches surface_oracle.comp over `inputs`.
+fn run_surface_oracle(
+    ctx: &std::sync::Arc<restir_pt::vk::Context>,
+    scene_gpu: &SceneGpu,
+    inputs: &[SurfaceOracleInput],
+) -> Vec<SurfaceOracleOutput> {
     let surface = scene_gpu.surface.as_ref().expect("the scene has attributes");
     assert_eq!(surface.buffers.len(), 4, "attributes and three texture buffers");
-    run_surface_set0_oracle(ctx, scene_gpu, "oracle/surface_oracle.comp", inputs, ITEMS, ROWS)
+    run_surface_set0_oracle(ctx, scene_gpu, "oracle/surface_oracle.comp", inputs)
 }
 
 /// Asserts item `i`'s GLSL outputs `g` against the Rust twins; false when the item was skipped
 /// because a nearest-filter lookup sits on a texel edge.
-fn check_item(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize) -> bool {
-    let (a, b) = (input[0], input[1]);
-    let tri = a.x.to_bits();
-    let bary = Vec2::new(a.y, a.z);
+fn check_item(scene: &Scene, input: &SurfaceOracleInput, g: &SurfaceOracleOutput, i: usize) -> bool {
+    let tri = input.triangle;
+    let bary = Vec2::from_array(input.bary);
     let s = surface_at(&scene.triangles[tri as usize], &scene.surfaces[tri as usize], bary);
-    assert_vec3_close(format!("surface_at normal, item {i}"), g[0].truncate(), s.normal, TOL);
-    assert_eq!(g[0].w, s.handedness, "surface_at handedness, item {i}");
-    assert_vec3_close(format!("surface_at tangent, item {i}"), g[1].truncate(), s.tangent, TOL);
+    assert_vec3_close(format!("surface_at normal, item {i}"), Vec3::from_array(g.normal), s.normal, TOL);
+    assert_eq!(g.handedness, s.handedness, "surface_at handedness, item {i}");
+    assert_vec3_close(format!("surface_at tangent, item {i}"), Vec3::from_array(g.tangent), s.tangent, TOL);
     let uv = Vec4::new(s.uv0.x, s.uv0.y, s.uv1.x, s.uv1.y);
-    assert!((g[2] - uv).abs().max_element() < 1e-4, "surface_at uv, item {i}: {} vs {uv}", g[2]);
-    let bary_rust = triangle_bary(&scene.triangles[tri as usize], input[2].truncate());
+    let g_uv = Vec4::new(g.uv0[0], g.uv0[1], g.uv1[0], g.uv1[1]);
+    assert!((g_uv - uv).abs().max_element() < 1e-4, "surface_at uv, item {i}: {g_uv} vs {uv}");
+    let bary_rust = triangle_bary(&scene.triangles[tri as usize], Vec3::from_array(input.point));
     assert!(
-        (g[7].truncate().truncate() - bary_rust).abs().max_element() < 1e-3,
+        (Vec2::from_array(g.bary) - bary_rust).abs().max_element() < 1e-3,
         "triangle_bary, item {i}"
     );
     assert!(
@@ -258,9 +262,9 @@ fn check_item(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize) -> bool {
     );
 
     let t = &scene.textures;
-    let texture = a.w.to_bits();
+    let texture = input.texture_index;
     let header = &t.headers[texture as usize];
-    let lookup_uv = Vec2::new(b.x, b.y);
+    let lookup_uv = Vec2::from_array(input.lookup_uv);
     let material = scene.triangles[tri as usize].material as usize;
     let mt = &t.materials[material];
     let slots = [mt.base_color, mt.metal_rough, mt.emissive, mt.normal];
@@ -271,59 +275,72 @@ fn check_item(scene: &Scene, input: &[Vec4], g: &[Vec4], i: usize) -> bool {
     if any_near_edge {
         return false;
     }
-    let c = texture_lookup(t, texture, lookup_uv, b.z > 0.5);
+    let c = texture_lookup(t, texture, lookup_uv, input.srgb != 0);
     for k in 0..4 {
-        assert!(close(g[3][k], c[k], TOL), "texture_lookup, item {i}: GLSL {} vs Rust {c}", g[3]);
+        assert!(
+            close(g.texel[k], c[k], TOL),
+            "texture_lookup, item {i}: GLSL {:?} vs Rust {c}",
+            g.texel
+        );
     }
     let coords = texture_coordinates(&mt.base_color, &s);
     assert!(
-        (Vec2::new(g[7].z, g[7].w) - coords).abs().max_element() < 1e-4,
+        (Vec2::from_array(g.base_color_uv) - coords).abs().max_element() < 1e-4,
         "texture_coordinates, item {i}"
     );
     check_textured_material(scene, material, &s, g, i);
-    check_shading_frame(scene, &g[8..10], tri, bary, i);
+    check_shading_frame(scene, g, tri, bary, i);
     let (tangent, handedness) = texture_tangent_frame(&mt.normal, &s);
-    assert_vec3_close(format!("texture_tangent_frame tangent, item {i}"), g[10].truncate(), tangent, 1e-3);
-    assert_eq!(g[10].w, handedness, "texture_tangent_frame handedness, item {i}");
-    assert_vec3_close(format!("vertex_color, item {i}"), g[11].truncate(), s.color, 1e-5);
+    assert_vec3_close(
+        format!("texture_tangent_frame tangent, item {i}"),
+        Vec3::from_array(g.frame_tangent),
+        tangent,
+        1e-3,
+    );
+    assert_eq!(g.frame_handedness, handedness, "texture_tangent_frame handedness, item {i}");
+    assert_vec3_close(format!("vertex_color, item {i}"), Vec3::from_array(g.color), s.color, 1e-5);
     true
 }
 
-/// textured_material and normal_mapped of item `i` (outputs 4 to 6) against their Rust twins.
-fn check_textured_material(scene: &Scene, material: usize, s: &SurfaceHit, g: &[Vec4], i: usize) {
+/// textured_material and normal_mapped of item `i` against their Rust twins.
+fn check_textured_material(scene: &Scene, material: usize, s: &SurfaceHit, g: &SurfaceOracleOutput, i: usize) {
     let (t, mt) = (&scene.textures, &scene.textures.materials[material]);
     let m = textured_material(&scene.materials[material], mt, t, s);
     assert_vec3_close(
         format!("textured_material base colour, item {i}"),
-        g[4].truncate(),
+        Vec3::from_array(g.base_color),
         m.base_color.into(),
         TOL,
     );
-    assert!(close(g[4].w, m.metallic, TOL), "textured_material metallic, item {i}");
+    assert!(close(g.metallic, m.metallic, TOL), "textured_material metallic, item {i}");
     assert_vec3_close(
         format!("textured_material emission, item {i}"),
-        g[5].truncate(),
+        Vec3::from_array(g.emission),
         m.emission.into(),
         TOL,
     );
-    assert!(close(g[5].w, m.roughness, TOL), "textured_material roughness, item {i}");
-    assert_vec3_close(format!("normal_mapped, item {i}"), g[6].truncate(), normal_mapped(mt, t, s), 1e-3);
+    assert!(close(g.roughness, m.roughness, TOL), "textured_material roughness, item {i}");
+    assert_vec3_close(
+        format!("normal_mapped, item {i}"),
+        Vec3::from_array(g.normal_mapped),
+        normal_mapped(mt, t, s),
+        1e-3,
+    );
 }
 
-/// GLSL `shading_normal` (row 0's xyz) and `hit_shading` (row 1's xyz the normal, the material's
-/// roughness and metallic in the rows' w) of item `i` against `Scene::shading_normal` and
-/// `Scene::hit_shading`.
-fn check_shading_frame(scene: &Scene, rows: &[Vec4], tri: u32, bary: Vec2, i: usize) {
+/// GLSL `shading_normal` and `hit_shading` (its normal, and its material's roughness and
+/// metallic) of item `i` against `Scene::shading_normal` and `Scene::hit_shading`.
+fn check_shading_frame(scene: &Scene, g: &SurfaceOracleOutput, tri: u32, bary: Vec2, i: usize) {
     let (m, ns) = scene.hit_shading(tri, bary);
     assert_vec3_close(
         format!("shading_normal, item {i}"),
-        rows[0].truncate(),
+        Vec3::from_array(g.shading_normal),
         scene.shading_normal(tri, bary),
         1e-3,
     );
-    assert_vec3_close(format!("hit_shading normal, item {i}"), rows[1].truncate(), ns, 1e-3);
+    assert_vec3_close(format!("hit_shading normal, item {i}"), Vec3::from_array(g.hit_normal), ns, 1e-3);
     assert!(
-        close(rows[0].w, m.roughness, TOL) && close(rows[1].w, m.metallic, TOL),
+        close(g.hit_roughness, m.roughness, TOL) && close(g.hit_metallic, m.metallic, TOL),
         "hit_shading material, item {i}"
     );
 }

@@ -4,7 +4,8 @@
 
 use std::sync::Arc;
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3};
+use restir_pt::oracle_types::{OracleRay, TracePairOracleInput, TracePairOracleOutput};
 use restir_pt::render::{RenderSettings, SceneGpu};
 use restir_pt::scene::{load_scene, Scene};
 use restir_pt::shading::bvh::{trace_closest, trace_occluded, trace_pair, Hit, PairRay, NO_HIT, SEGMENT_EPSILON};
@@ -50,19 +51,22 @@ fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairR
     )
     .unwrap();
     params.write(&[RenderSettings::default().frame_params(scene_gpu.info())]).unwrap();
-    let inputs: Vec<Vec4> = pairs
+    let ray = |r: &PairRay| OracleRay {
+        origin: r.origin.to_array(),
+        tmax: r.tmax,
+        dir: r.dir.to_array(),
+        pad: 0.0,
+    };
+    let inputs: Vec<TracePairOracleInput> = pairs
         .iter()
-        .flat_map(|(c, s)| {
-            [
-                c.origin.extend(c.tmax),
-                c.dir.extend(0.0),
-                s.origin.extend(s.tmax),
-                s.dir.extend(0.0),
-            ]
+        .map(|(c, s)| TracePairOracleInput {
+            closest: ray(c),
+            shadow: ray(s),
         })
         .collect();
     let input = Buffer::from_slice(ctx, "pairs", &inputs).unwrap();
-    let output = Buffer::new(ctx, "hits", pairs.len() as u64 * 32, BufferUsage::Storage).unwrap();
+    let output_size = std::mem::size_of::<TracePairOracleOutput>() as u64;
+    let output = Buffer::new(ctx, "hits", pairs.len() as u64 * output_size, BufferUsage::Storage).unwrap();
     let mut defines = scene_gpu.defines();
     defines.push(("SCENE_BRUTE_FORCE", if brute_force { "1" } else { "0" }));
     let mut buffers = scene_gpu.buffers(&params);
@@ -75,15 +79,15 @@ fn run_gpu(ctx: &Arc<Context>, scene: &Scene, brute_force: bool, pairs: &[(PairR
     kernel.bind(&buffers).unwrap();
     let count = pairs.len() as u32;
     kernel.run_1d(count, 64, bytemuck::bytes_of(&count)).unwrap();
-    let out = output.read::<Vec4>(2 * pairs.len()).unwrap();
-    out.chunks(2)
+    let out = output.read::<TracePairOracleOutput>(pairs.len()).unwrap();
+    out.iter()
         .map(|o| {
             let hit = Hit {
-                t: o[0].x,
-                triangle: o[0].y.to_bits(),
-                bary: glam::Vec2::new(o[0].z, o[0].w),
+                t: o.hit.t,
+                triangle: o.hit.triangle,
+                bary: Vec2::from_array(o.hit.bary),
             };
-            (hit, o[1].x == 1.0)
+            (hit, o.occluded == 1)
         })
         .collect()
 }
