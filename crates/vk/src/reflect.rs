@@ -54,6 +54,22 @@ const OP_ATOMIC_FIRST_READ_WRITE: u32 = 229; // OpAtomicExchange
 const OP_ATOMIC_LAST_READ_WRITE: u32 = 242; // OpAtomicXor
 const OP_ATOMIC_FADD_EXT: u32 = 6035;
 
+/// The instructions of a SPIR-V module (its words, the 5-word header included) as (opcode,
+/// operands), in order; a malformed instruction ends them rather than panics.
+fn instructions(spirv: &[u32]) -> impl Iterator<Item = (u32, &[u32])> {
+    let mut i = 5;
+    std::iter::from_fn(move || {
+        let word = *spirv.get(i)?;
+        let (count, op) = ((word >> 16) as usize, word & 0xffff);
+        if count == 0 || i + count > spirv.len() {
+            return None;
+        }
+        let args = &spirv[i + 1..i + count];
+        i += count;
+        Some((op, args))
+    })
+}
+
 /// Which variables the module's functions read and write: pointers derived by access chains
 /// (and copies) are traced to their variable, then loads, stores, atomics, array lengths and
 /// pointer arguments of calls mark it. The map holds only variables that were accessed.
@@ -61,14 +77,7 @@ fn variable_access(spirv: &[u32]) -> HashMap<u32, (bool, bool)> {
     let mut root: HashMap<u32, u32> = HashMap::new();
     let mut access: HashMap<u32, (bool, bool)> = HashMap::new();
     let mut in_functions = false;
-    let mut i = 5;
-    while i < spirv.len() {
-        let (count, op) = ((spirv[i] >> 16) as usize, spirv[i] & 0xffff);
-        if count == 0 || i + count > spirv.len() {
-            break;
-        }
-        let args = &spirv[i + 1..i + count];
-        i += count;
+    for (op, args) in instructions(spirv) {
         match op {
             OP_VARIABLE if args.len() >= 2 => {
                 root.insert(args[1], args[1]);
@@ -125,13 +134,7 @@ pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
     let mut decorations: HashMap<(u32, u32), u32> = HashMap::new();
     let mut pointers = HashMap::new();
     let mut variables = Vec::new();
-    let mut i = 5;
-    while i < spirv.len() {
-        let (count, op) = ((spirv[i] >> 16) as usize, spirv[i] & 0xffff);
-        if count == 0 || i + count > spirv.len() {
-            break;
-        }
-        let args = &spirv[i + 1..i + count];
+    for (op, args) in instructions(spirv) {
         match op {
             OP_NAME if !args.is_empty() => {
                 names.insert(args[0], spirv_string(&args[1..]));
@@ -145,7 +148,6 @@ pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
             OP_VARIABLE if args.len() >= 3 => variables.push((args[0], args[1], args[2])),
             _ => {}
         }
-        i += count;
     }
     let mut out: Vec<(ReflectedBinding, u32)> = variables
         .into_iter()
