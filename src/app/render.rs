@@ -318,8 +318,13 @@ pub fn render(args: RenderArgs) -> Result<()> {
         eprintln!("{line}");
     }
     if !args.is_static() && args.frames.is_some_and(|f| f > 1) && scene.cameras.len() < 2 {
+        let which = if scene.cameras[0].name == restir_pt::scene::DEFAULT_CAMERA_NAME {
+            "no camera, so the default camera framing it"
+        } else {
+            "one camera, so the camera"
+        };
         eprintln!(
-            "warning: {}: the scene has one camera, so the camera cannot move; every frame is seen from it",
+            "warning: {}: the scene has {which} cannot move; every frame is seen from it",
             path.display()
         );
     }

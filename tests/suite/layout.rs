@@ -273,6 +273,26 @@ fn records_and_constants_are_declared_only_in_rust() {
     let mut rust = Vec::new();
     repository_files(root, "rs", &mut rust);
     assert!(rust.len() > 50, "the repository's Rust sources are found: {}", rust.len());
+    // Every record `gpu_record!` declares is listed in `records()`, so the header has it.
+    let interface = root.join("crates/interface/src");
+    for path in rust.iter().filter(|p| p.starts_with(&interface)) {
+        let text = std::fs::read_to_string(path).expect("readable source");
+        let mut lines = text.lines().map(str::trim);
+        while let Some(line) = lines.next() {
+            if line != "gpu_record! {" {
+                continue;
+            }
+            let declared = lines
+                .find_map(|l| l.strip_prefix("pub struct "))
+                .and_then(|l| l.split_whitespace().next());
+            if let Some(name) = declared.filter(|n| !all.iter().any(|r| r.name == *n)) {
+                problems.push(format!(
+                    "{}: {name} is declared by gpu_record! but not listed in shader_interface::records()",
+                    path.display()
+                ));
+            }
+        }
+    }
     let repr_c = "#[repr(".to_string() + "C)]";
     for path in rust.iter().filter(|p| !p.ends_with("crates/interface/src/glsl_record.rs")) {
         let text = std::fs::read_to_string(path).expect("readable source");

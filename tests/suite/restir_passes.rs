@@ -39,18 +39,15 @@ fn each_pass_row_names_the_buffers_its_kernel_reads_and_writes() {
             ("MIS_MODE", ReuseMis::GeneralizedBalance.glsl_name()),
         ];
         let (reads, writes) = accessed(row.kernel, &default);
-        assert_eq!(
-            reads,
-            names(row.reads),
-            "{:?}: buffers read (SPIR-V left, PASSES right)",
-            row.kernel
-        );
-        assert_eq!(
-            writes,
-            names(row.writes),
-            "{:?}: buffers written (SPIR-V left, PASSES right)",
-            row.kernel
-        );
+        for (what, used, declared) in [("reads", reads, names(row.reads)), ("writes", writes, names(row.writes))] {
+            let missing: Vec<&String> = used.difference(&declared).collect();
+            let unused: Vec<&String> = declared.difference(&used).collect();
+            assert!(
+                missing.is_empty() && unused.is_empty(),
+                "{:?} {what}: missing from its PASSES row {missing:?}; in the row but not in the SPIR-V {unused:?}",
+                row.kernel
+            );
+        }
     }
 }
 

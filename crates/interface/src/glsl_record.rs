@@ -208,7 +208,10 @@ macro_rules! gpu_record {
                 offset = round_up(offset, <$ty as GlslType>::ALIGN);
                 assert!(
                     offset == ::std::mem::offset_of!($name, $field),
-                    concat!(stringify!($name), "::", stringify!($field), ": the Rust offset is not the std430 offset")
+                    concat!(
+                        stringify!($name), "::", stringify!($field),
+                        ": the Rust offset is not the std430 offset (std430 starts a vec3/[f32; 3] or vec4 on 16 bytes, a vec2 on 8: pad before it with u32 fields)"
+                    )
                 );
                 offset += <$ty as GlslType>::SIZE;
             )*

@@ -10,6 +10,8 @@ pub const DEFAULT_IMAGE_SIDE: u32 = 256;
 /// From the scene's centre towards the default camera: normalize(0, 1, 2).
 pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(0.0, 0.447_213_6, 0.894_427_2);
 
+/// The name of the camera the loader makes for a file without cameras, framing the scene.
+pub const DEFAULT_CAMERA_NAME: &str = "default camera";
 /// Vertical field of view of the default camera (45 degrees).
 pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
@@ -66,7 +68,7 @@ impl Camera {
         let eye = centre + DEFAULT_VIEW_DIRECTION * distance;
         Camera {
             aspect_ratio: Some(1.0),
-            ..Camera::look_at("default camera", eye, centre, Vec3::Y, DEFAULT_YFOV)
+            ..Camera::look_at(DEFAULT_CAMERA_NAME, eye, centre, Vec3::Y, DEFAULT_YFOV)
         }
     }
 

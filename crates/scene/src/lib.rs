@@ -33,7 +33,7 @@ pub mod light_tree;
 pub mod many_lights_scene;
 mod punctual;
 
-pub use camera::{camera_on_path, Camera, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
+pub use camera::{camera_on_path, Camera, DEFAULT_CAMERA_NAME, DEFAULT_IMAGE_SIDE, DEFAULT_VIEW_DIRECTION, DEFAULT_YFOV};
 pub use gltf_json::check_gltf_start;
 pub use gltf_loader::{
     load_scene, load_scene_from_bytes, load_scene_from_bytes_with_options, load_scene_reporting, ArrayLimit, LoadOptions,
