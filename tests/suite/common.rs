@@ -38,6 +38,33 @@ pub fn repo_path(relative: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
 }
 
+/// The files with extension `ext` under `dir` (a path from the repository's root, "" for all of
+/// it), as paths from the root with '/' separators, sorted; build output, git's and Python's
+/// environment folders are skipped.
+pub fn repository_files(dir: &str, ext: &str) -> Vec<String> {
+    fn walk(relative: &str, ext: &str, out: &mut Vec<String>) {
+        for entry in std::fs::read_dir(repo_path(relative)).expect("readable folder").flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let path = if relative.is_empty() {
+                name.clone()
+            } else {
+                format!("{relative}/{name}")
+            };
+            if entry.path().is_dir() {
+                if !matches!(name.as_str(), "target" | ".git" | ".venv" | "node_modules") {
+                    walk(&path, ext, out);
+                }
+            } else if entry.path().extension().is_some_and(|e| e == ext) {
+                out.push(path);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, ext, &mut out);
+    out.sort();
+    out
+}
+
 /// Runs an oracle kernel over `count` items. The `leading` buffers keep their bindings; the
 /// storage blocks named in `inputs` follow them in order, then the block `Outputs` of
 /// `output_words` 32-bit words pre-filled with NaN, which is returned. Kernel::new checks each

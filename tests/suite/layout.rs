@@ -8,12 +8,14 @@
 
 use std::collections::HashMap;
 
+use crate::common::{repo_path, repository_files};
+
 use restir_pt::glsl_record::{upper_snake, GlslDeclaration};
 use restir_pt::render::{PassKernel, ReuseMis, ShiftKind};
 use restir_pt::shader_interface::{records, PathTraceBinding, RestirBinding, SceneBinding, SurfaceBinding, GLSL_HEADER_NAME};
 use restir_pt::vk::{
-    check_bindings, compile_glsl_source, compile_kernel, glsl_source, reflect_bindings, Binding, BindingFamilyExt, BindingSlot,
-    GLSL_SOURCES,
+    check_bindings, compile_glsl_source, compile_kernel, glsl_source, reflect_bindings, spirv_instructions, Binding, BindingFamilyExt,
+    BindingSlot, GLSL_SOURCES,
 };
 
 const OP_NAME: u32 = 5;
@@ -41,10 +43,7 @@ fn spirv_string(words: &[u32]) -> String {
 
 fn reflect(spirv: &[u32]) -> Reflection {
     let mut r = Reflection::default();
-    let mut i = 5;
-    while i < spirv.len() {
-        let (count, op) = ((spirv[i] >> 16) as usize, spirv[i] & 0xffff);
-        let args = &spirv[i + 1..i + count];
+    for (op, args) in spirv_instructions(spirv) {
         match op {
             OP_NAME => {
                 r.names.insert(args[0], spirv_string(&args[1..]));
@@ -61,7 +60,6 @@ fn reflect(spirv: &[u32]) -> Reflection {
             OP_TYPE_ARRAY | OP_TYPE_RUNTIME_ARRAY => r.array_elements.push((args[0], args[1])),
             _ => {}
         }
-        i += count.max(1);
     }
     r
 }
@@ -220,20 +218,6 @@ fn every_declared_record_matches_glslang_layout() {
     assert_eq!(check_spirv_layout("every_record.comp", &spirv, layouts(&names)), all.len());
 }
 
-fn repository_files(dir: &std::path::Path, ext: &str, out: &mut Vec<std::path::PathBuf>) {
-    for entry in std::fs::read_dir(dir).expect("readable folder").flatten() {
-        let path = entry.path();
-        let name = entry.file_name();
-        if path.is_dir() {
-            if !matches!(name.to_str(), Some("target" | ".git" | ".venv" | "node_modules")) {
-                repository_files(&path, ext, out);
-            }
-        } else if path.extension().is_some_and(|e| e == ext) {
-            out.push(path);
-        }
-    }
-}
-
 /// Records and constants are written once, in Rust: no GLSL source declares a struct of a
 /// record's name, a block of a block record's name without its generated member list, or a
 /// constant the header generates; and no Rust source outside the `gpu_record!` macro writes
@@ -269,14 +253,15 @@ fn records_and_constants_are_declared_only_in_rust() {
             }
         }
     }
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut rust = Vec::new();
-    repository_files(root, "rs", &mut rust);
+    let rust = repository_files("", "rs");
     assert!(rust.len() > 50, "the repository's Rust sources are found: {}", rust.len());
-    // Every record `gpu_record!` declares is listed in `records()`, so the header has it.
-    let interface = root.join("crates/interface/src");
-    for path in rust.iter().filter(|p| p.starts_with(&interface)) {
-        let text = std::fs::read_to_string(path).expect("readable source");
+    let repr_c = "#[repr(".to_string() + "C)]";
+    for path in &rust {
+        let text = std::fs::read_to_string(repo_path(path)).expect("readable source");
+        if path != "crates/interface/src/glsl_record.rs" && text.lines().any(|l| l.trim() == repr_c) {
+            problems.push(format!("{path}: a `{repr_c}` struct not declared by gpu_record!"));
+        }
+        // Every record `gpu_record!` declares is listed in `records()`, so the header has it.
         let mut lines = text.lines().map(str::trim);
         while let Some(line) = lines.next() {
             if line != "gpu_record! {" {
@@ -287,17 +272,9 @@ fn records_and_constants_are_declared_only_in_rust() {
                 .and_then(|l| l.split_whitespace().next());
             if let Some(name) = declared.filter(|n| !all.iter().any(|r| r.name == *n)) {
                 problems.push(format!(
-                    "{}: {name} is declared by gpu_record! but not listed in shader_interface::records()",
-                    path.display()
+                    "{path}: {name} is declared by gpu_record! but not listed in shader_interface::records()"
                 ));
             }
-        }
-    }
-    let repr_c = "#[repr(".to_string() + "C)]";
-    for path in rust.iter().filter(|p| !p.ends_with("crates/interface/src/glsl_record.rs")) {
-        let text = std::fs::read_to_string(path).expect("readable source");
-        if text.lines().any(|l| l.trim() == repr_c) {
-            problems.push(format!("{}: a `{repr_c}` struct not declared by gpu_record!", path.display()));
         }
     }
     assert!(problems.is_empty(), "written by hand:\n{}", problems.join("\n"));
@@ -308,11 +285,10 @@ fn records_and_constants_are_declared_only_in_rust() {
 /// are how twins drift apart. Placeholders in capitals (`scenes/NAME.gltf`) are not paths.
 #[test]
 fn no_source_or_document_names_a_missing_file() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files = Vec::new();
-    for ext in ["rs", "md", "glsl", "comp", "py", "sh", "toml"] {
-        repository_files(root, ext, &mut files);
-    }
+    let files: Vec<String> = ["rs", "md", "glsl", "comp", "py", "sh", "toml"]
+        .iter()
+        .flat_map(|ext| repository_files("", ext))
+        .collect();
     let folders = [
         "glsl", "crates", "src", "tests", "docs", "tools", "scenes", "python", "examples", "fuzz",
     ];
@@ -320,7 +296,7 @@ fn no_source_or_document_names_a_missing_file() {
     let path_char = |c: char| c.is_ascii_alphanumeric() || "_./-".contains(c);
     let mut missing = Vec::new();
     for file in &files {
-        let text = std::fs::read_to_string(file).expect("readable source");
+        let text = std::fs::read_to_string(repo_path(file)).expect("readable source");
         for (start, _) in text.match_indices('/') {
             let head = text[..start]
                 .char_indices()
@@ -338,8 +314,8 @@ fn no_source_or_document_names_a_missing_file() {
             let placeholder = path[..path.len() - ext.len()]
                 .split('/')
                 .any(|w| !w.is_empty() && w.chars().all(|c| c.is_ascii_uppercase()));
-            if !placeholder && !root.join(path).exists() {
-                missing.push(format!("{}: {path}", file.strip_prefix(root).unwrap_or(file).display()));
+            if !placeholder && !repo_path(path).exists() {
+                missing.push(format!("{file}: {path}"));
             }
         }
     }

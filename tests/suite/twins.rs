@@ -7,7 +7,8 @@
 //! scanning, not parsing: the GLSL of this repository defines functions at the start of a line.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+
+use crate::common::{repo_path, repository_files};
 
 /// (GLSL function, its file under glsl/, its Rust twin's file under the src/ of the crate that
 /// the GLSL file's folder mirrors, the oracle test's file under tests/suite/, the oracle test).
@@ -86,7 +87,7 @@ const NO_ORACLE: &[(&str, &str, &str)] = &[(
 const MIRRORS: &[(&str, &str)] = &[("shading_core", "shading-core"), ("shading", "shading"), ("scene", "scene")];
 
 fn read(relative: &str) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(relative);
+    let path = repo_path(relative);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -180,19 +181,6 @@ fn test_body<'a>(source: &'a str, name: &str) -> Option<&'a str> {
     Some(&rest[..rest.find("\n}").unwrap_or(rest.len())])
 }
 
-/// The files under `dir` (a path from the repository's root) with the extension `ext`.
-fn files_under(dir: &str, ext: &str, out: &mut Vec<String>) {
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
-    for entry in std::fs::read_dir(folder).expect("readable folder").flatten() {
-        let name = format!("{dir}/{}", entry.file_name().to_string_lossy());
-        if entry.path().is_dir() {
-            files_under(&name, ext, out);
-        } else if entry.path().extension().is_some_and(|e| e == ext) {
-            out.push(name);
-        }
-    }
-}
-
 #[test]
 fn twins_table_rows_name_glsl_rust_and_oracle_test() {
     for &(name, glsl, rust, test_file, test) in TWINS {
@@ -220,11 +208,11 @@ fn twins_every_same_named_pair_is_in_the_table_or_compared_through_it() {
     let mut definitions: BTreeMap<String, Vec<String>> = BTreeMap::new();
     let mut pairs = Vec::new();
     for &(folder, krate) in MIRRORS {
-        let (mut rust_files, mut glsl_files) = (Vec::new(), Vec::new());
-        files_under(&format!("crates/{krate}/src"), "rs", &mut rust_files);
-        files_under(&format!("glsl/{folder}"), "glsl", &mut glsl_files);
-        let rust: String = rust_files.iter().map(|f| read(f)).collect();
-        for file in glsl_files {
+        let rust: String = repository_files(&format!("crates/{krate}/src"), "rs")
+            .iter()
+            .map(|f| read(f))
+            .collect();
+        for file in repository_files(&format!("glsl/{folder}"), "glsl") {
             let file = file.strip_prefix("glsl/").expect("under glsl/").to_string();
             for (name, body) in glsl_definitions(&read(&format!("glsl/{file}"))) {
                 if defines_rust_fn(&rust, &name) {

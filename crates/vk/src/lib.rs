@@ -32,7 +32,7 @@ pub use device_list::{list_devices, DeviceSummary};
 pub use kernel::{
     record_compute_barrier, record_host_read_barrier, Binding, BindingFamilyExt, BindingSlot, BoundBuffer, Kernel, KernelCompile,
 };
-pub use reflect::{check_bindings, reflect_bindings, ReflectedBinding};
+pub use reflect::{check_bindings, reflect_bindings, spirv_instructions, ReflectedBinding};
 pub use shader::{
     compile_glsl_source, compile_kernel, compile_kernel_cached_in, compile_kernels_in_parallel, glsl_source, process_cpu_ms,
     set_compile_threads, thread_cpu_ms, CompiledKernel, GLSL_SOURCES,

@@ -56,7 +56,7 @@ const OP_ATOMIC_FADD_EXT: u32 = 6035;
 
 /// The instructions of a SPIR-V module (its words, the 5-word header included) as (opcode,
 /// operands), in order; a malformed instruction ends them rather than panics.
-fn instructions(spirv: &[u32]) -> impl Iterator<Item = (u32, &[u32])> {
+pub fn spirv_instructions(spirv: &[u32]) -> impl Iterator<Item = (u32, &[u32])> {
     let mut i = 5;
     std::iter::from_fn(move || {
         let word = *spirv.get(i)?;
@@ -77,7 +77,7 @@ fn variable_access(spirv: &[u32]) -> HashMap<u32, (bool, bool)> {
     let mut root: HashMap<u32, u32> = HashMap::new();
     let mut access: HashMap<u32, (bool, bool)> = HashMap::new();
     let mut in_functions = false;
-    for (op, args) in instructions(spirv) {
+    for (op, args) in spirv_instructions(spirv) {
         match op {
             OP_VARIABLE if args.len() >= 2 => {
                 root.insert(args[1], args[1]);
@@ -134,7 +134,7 @@ pub fn reflect_bindings(spirv: &[u32]) -> Vec<ReflectedBinding> {
     let mut decorations: HashMap<(u32, u32), u32> = HashMap::new();
     let mut pointers = HashMap::new();
     let mut variables = Vec::new();
-    for (op, args) in instructions(spirv) {
+    for (op, args) in spirv_instructions(spirv) {
         match op {
             OP_NAME if !args.is_empty() => {
                 names.insert(args[0], spirv_string(&args[1..]));
